@@ -1,0 +1,54 @@
+// Scenes in, results out: the JSON contract of the `nhi` runner.
+//
+// A scene is a JSON object with the keys
+//   system         "particle"                                   (required)
+//   params         object of system parameters                  (default: the system's)
+//   q0, v0         arrays of n numbers; v0 must satisfy omega(q0) v0 = 0   (required)
+//   method         "dla" | "rk4" | "benchmark"                   (required)
+//   discretization "alpha" | "symmetric"                         (default "alpha")
+//   alpha          number in [0, 1]                              (default 0.5)
+//   h              number > 0                                    (required)
+//   steps          integer >= 1                                  (required)
+//   tolerance      number in (0, 1): DLA relative residual (default 1e-12),
+//                  CVODE rtol = atol for the benchmark (default 1e-12); unused by rk4
+//   output_every   integer >= 1: record steps 0, s, 2s, ... and the last (default 1)
+// Unknown keys are rejected (a misspelt key must not silently fall back to a default).
+// validate_scene() returns the resolved scene with every default filled in, or
+// throws SceneError naming the key and the problem.  run_scene() runs it and
+// returns the result object (see README.md, "Result format").
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace nhi {
+
+using json = nlohmann::json;
+
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Parse a scene file (throws SceneError on unreadable or malformed JSON).
+json load_scene_file(const std::string& path);
+
+// Apply one `--set key=value` override.  The value is parsed as JSON; if that
+// fails it is taken as a string (so `--set method=rk4` works).  A dotted key
+// `params.kx=2` sets one system parameter.
+void apply_override(json* scene, const std::string& assignment);
+
+// Check every key; return the scene with defaults filled in.
+json validate_scene(const json& scene);
+
+// Run a validated scene.  Never throws for a failed step: that is status "failed".
+json run_scene(const json& resolved);
+
+// Provenance of a result: git revision and dirtiness, compiler, library versions, time.
+json meta();
+
+// Names the runner knows (for messages and tests).
+std::vector<std::string> system_names();
+
+}  // namespace nhi

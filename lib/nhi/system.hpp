@@ -1,0 +1,144 @@
+// The *system* role: a Lagrangian L(q, qdot) and m constraint one-forms omega(q)
+// (motions satisfy omega(q) qdot = 0, paper eq. 4), and what follows from them
+// generically by automatic differentiation.
+//
+// A system is a plain type with
+//   static constexpr int n, m;                       // dim Q, number of constraints
+//   static constexpr const char* name;
+//   template <class T> T lagrangian(const Vec<T,n>& q, const Vec<T,n>& v) const;
+//   template <class T> Mat<T,m,n> omega(const Vec<T,n>& q) const;
+//   Vec<double,n> acceleration(const Vec<double,n>& q, const Vec<double,n>& v) const;
+// and optionally
+//   template <class T> void partials(q, v, Vec<T,n>* dLdq, Vec<T,n>* dLdv) const;
+// acceleration() is the index-reduced ODE (constraint differentiated once, multiplier
+// eliminated, paper section 6.1) written out by hand for speed; the tests check
+// it against generic_acceleration() below, which derives it from L and omega.
+// partials() is the same kind of fast path for the DLA step: without it the
+// step's Jacobian needs a Jet of Jets, about ten times slower.
+#pragma once
+
+#include <Eigen/Dense>
+#include <type_traits>
+#include <utility>
+
+#include "nhi/core.hpp"
+
+namespace nhi {
+
+// Does the system hand-write its partials (the optional fast path)?
+template <class S, class T, class = void>
+struct has_partials : std::false_type {};
+template <class S, class T>
+struct has_partials<S, T,
+                    std::void_t<decltype(std::declval<const S&>().template partials<T>(
+                        std::declval<const Vec<T, S::n>&>(), std::declval<const Vec<T, S::n>&>(),
+                        std::declval<Vec<T, S::n>*>(), std::declval<Vec<T, S::n>*>()))>>
+    : std::true_type {};
+
+// dL/dq and dL/dqdot at (q, v) by autodiff of L: one forward-mode Jet over the
+// 2n inputs.  T may itself be a Jet (then this is a Jet of Jets: exact, slow).
+template <class S, class T>
+inline void autodiff_partials(const S& sys, const Vec<T, S::n>& q, const Vec<T, S::n>& v,
+                              Vec<T, S::n>* dLdq, Vec<T, S::n>* dLdv) {
+  constexpr int n = S::n;
+  using J = ceres::Jet<T, 2 * n>;
+  Vec<J, n> qj, vj;
+  for (int i = 0; i < n; ++i) {
+    qj[i] = J(q[i], i);
+    vj[i] = J(v[i], n + i);
+  }
+  const J L = sys.template lagrangian<J>(qj, vj);
+  for (int i = 0; i < n; ++i) {
+    (*dLdq)[i] = L.v[i];
+    (*dLdv)[i] = L.v[n + i];
+  }
+}
+
+// dL/dq and dL/dqdot at (q, v): the system's hand-written partials<T>() if it
+// has them (the fast path; tests/test_systems.cpp checks them against
+// autodiff_partials to round-off, for double and for Jet), else autodiff.
+template <class S, class T>
+inline void lagrangian_partials(const S& sys, const Vec<T, S::n>& q, const Vec<T, S::n>& v,
+                                Vec<T, S::n>* dLdq, Vec<T, S::n>* dLdv) {
+  if constexpr (has_partials<S, T>::value) {
+    sys.template partials<T>(q, v, dLdq, dLdv);
+  } else {
+    autodiff_partials(sys, q, v, dLdq, dLdv);
+  }
+}
+
+// Momentum p = dL/dqdot.
+template <class S>
+inline Vec<double, S::n> momentum(const S& sys, const Vec<double, S::n>& q,
+                                  const Vec<double, S::n>& v) {
+  Vec<double, S::n> dq, dv;
+  lagrangian_partials(sys, q, v, &dq, &dv);
+  return dv;
+}
+
+// Energy E = dL/dqdot . v - L.
+template <class S>
+inline double energy(const S& sys, const Vec<double, S::n>& q, const Vec<double, S::n>& v) {
+  Vec<double, S::n> dq, dv;
+  lagrangian_partials(sys, q, v, &dq, &dv);
+  return dv.dot(v) - sys.template lagrangian<double>(q, v);
+}
+
+// Constraint values omega(q) v (zero along motions).
+template <class S>
+inline Vec<double, S::m> constraint_values(const S& sys, const Vec<double, S::n>& q,
+                                           const Vec<double, S::n>& v) {
+  return sys.template omega<double>(q) * v;
+}
+
+// The index-reduced ODE derived from L and omega alone:
+//   M a + C v - dL/dq = omega^T lambda              (paper eq. 3)
+//   omega a + d(omega(q) v)/dq v = 0                (eq. 4 differentiated)
+// with M = d2L/dqdot2, C = d2L/dqdot dq.  Returns a; *lambda gets the multiplier.
+// Used to check each scene's hand-written acceleration(), not on the hot path.
+template <class S>
+inline Vec<double, S::n> generic_acceleration(const S& sys, const Vec<double, S::n>& q,
+                                              const Vec<double, S::n>& v,
+                                              Vec<double, S::m>* lambda = nullptr) {
+  constexpr int n = S::n, m = S::m;
+  using J = ceres::Jet<double, 2 * n>;
+  Vec<J, n> qj, vj;
+  for (int i = 0; i < n; ++i) {
+    qj[i] = J(q[i], i);
+    vj[i] = J(v[i], n + i);
+  }
+  Vec<J, n> dq, dv;
+  autodiff_partials(sys, qj, vj, &dq, &dv);
+  Mat<double, n, n> M, C;
+  Vec<double, n> f;
+  for (int i = 0; i < n; ++i) {
+    f[i] = dq[i].a;
+    for (int j = 0; j < n; ++j) {
+      C(i, j) = dv[i].v[j];
+      M(i, j) = dv[i].v[n + j];
+    }
+  }
+  const Mat<J, m, n> Wj = sys.template omega<J>(qj);
+  Mat<double, m, n> W;
+  Vec<double, m> wdot = Vec<double, m>::Zero();  // d(omega(q) v)/dq . v
+  for (int a = 0; a < m; ++a) {
+    for (int j = 0; j < n; ++j) W(a, j) = Wj(a, j).a;
+    for (int k = 0; k < n; ++k) {
+      double dk = 0;
+      for (int j = 0; j < n; ++j) dk += Wj(a, j).v[k] * v[j];
+      wdot[a] += dk * v[k];
+    }
+  }
+  Mat<double, n + m, n + m> K = Mat<double, n + m, n + m>::Zero();
+  K.template topLeftCorner<n, n>() = M;
+  K.template topRightCorner<n, m>() = -W.transpose();
+  K.template bottomLeftCorner<m, n>() = W;
+  Vec<double, n + m> b;
+  b.template head<n>() = f - C * v;
+  b.template tail<m>() = -wdot;
+  const Vec<double, n + m> x = K.fullPivLu().solve(b);
+  if (lambda) *lambda = x.template tail<m>();
+  return x.template head<n>();
+}
+
+}  // namespace nhi

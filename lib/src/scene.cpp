@@ -1,0 +1,280 @@
+// Scene validation and the runner behind `nhi run` (contract in scene.hpp and README.md).
+#include "nhi/scene.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <sstream>
+
+#include "nhi/integrate.hpp"
+#include "nhi/observer.hpp"
+#include "nhi/systems/particle.hpp"
+
+namespace nhi {
+namespace {
+
+[[noreturn]] void fail(const std::string& key, const std::string& problem) {
+  throw SceneError("scene key '" + key + "': " + problem);
+}
+
+std::string show(const json& j) {
+  std::string s = j.dump();
+  return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+}
+
+double finite_number(const json& j, const std::string& key) {
+  if (!j.is_number()) fail(key, "must be a number, got " + show(j));
+  const double x = j.get<double>();
+  if (!std::isfinite(x)) fail(key, "must be finite, got " + show(j));
+  return x;
+}
+
+long integer(const json& j, const std::string& key, long lo, long hi) {
+  if (j.is_number_float()) {
+    const double x = j.get<double>();
+    if (!std::isfinite(x) || x != std::floor(x))
+      fail(key, "must be an integer, got " + show(j));
+    if (x < double(lo) || x > double(hi))
+      fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + show(j));
+    return static_cast<long>(x);
+  }
+  if (j.is_number_unsigned()) {
+    const auto u = j.get<unsigned long long>();
+    if (u > static_cast<unsigned long long>(hi) || static_cast<long>(u) < lo)
+      fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + show(j));
+    return static_cast<long>(u);
+  }
+  if (j.is_number_integer()) {
+    const long x = j.get<long>();
+    if (x < lo || x > hi)
+      fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + show(j));
+    return x;
+  }
+  fail(key, "must be an integer, got " + show(j));
+}
+
+std::string one_of(const json& j, const std::string& key, const std::vector<std::string>& names) {
+  std::string list;
+  for (const auto& s : names) list += (list.empty() ? "" : ", ") + ("\"" + s + "\"");
+  if (!j.is_string()) fail(key, "must be one of " + list + ", got " + show(j));
+  const std::string s = j.get<std::string>();
+  if (std::find(names.begin(), names.end(), s) == names.end())
+    fail(key, "unknown value \"" + s + "\" (expected one of " + list + ")");
+  return s;
+}
+
+template <int N>
+Vec<double, N> vector_of(const json& j, const std::string& key) {
+  if (!j.is_array()) fail(key, "must be an array of " + std::to_string(N) + " numbers, got " + show(j));
+  if (j.size() != N)
+    fail(key, "must have " + std::to_string(N) + " entries for this system, got " +
+                  std::to_string(j.size()));
+  Vec<double, N> v;
+  for (int i = 0; i < N; ++i) v[i] = finite_number(j[i], key + "[" + std::to_string(i) + "]");
+  return v;
+}
+
+template <int N>
+json to_json(const Vec<double, N>& v) {
+  json a = json::array();
+  for (int i = 0; i < N; ++i) a.push_back(v[i]);
+  return a;
+}
+
+// Per-system glue: parameters from JSON, defaults.  Each scene file stays free of JSON.
+template <class S>
+struct SceneTraits;
+
+template <>
+struct SceneTraits<Particle> {
+  static Particle make(const json& params, json* resolved) {
+    Particle p;
+    for (const auto& [key, value] : params.items()) {
+      if (key == "kx") p.kx = finite_number(value, "params.kx");
+      else if (key == "ky") p.ky = finite_number(value, "params.ky");
+      else fail("params." + key, "unknown parameter for system \"particle\" (known: kx, ky)");
+    }
+    *resolved = {{"kx", p.kx}, {"ky", p.ky}};
+    return p;
+  }
+};
+
+// Call f(system) with the concrete system type named in the scene.
+template <class F>
+auto with_system(const json& scene, json* resolved_params, F&& f) {
+  const std::string name = scene.at("system").get<std::string>();
+  const json params = scene.contains("params") ? scene.at("params") : json::object();
+  if (name == "particle") return f(SceneTraits<Particle>::make(params, resolved_params));
+  fail("system", "unknown system \"" + name + "\"");
+}
+
+const std::vector<std::string> kKeys = {"system", "params", "q0",    "v0",        "method",
+                                        "discretization", "alpha", "h", "steps", "tolerance",
+                                        "output_every"};
+
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+template <class S>
+json run_system(const S& sys, const json& sc) {
+  constexpr int n = S::n;
+  const Vec<double, n> q0 = vector_of<n>(sc["q0"], "q0");
+  const Vec<double, n> v0 = vector_of<n>(sc["v0"], "v0");
+  const std::string method = sc["method"];
+  const double h = sc["h"], alpha = sc["alpha"], tol = sc["tolerance"];
+  const long steps = sc["steps"], every = sc["output_every"];
+
+  Recorder<S> rec(sys, every, steps);
+  const double cpu0 = cpu_seconds();
+  const auto wall0 = std::chrono::steady_clock::now();
+  RunReport rep;
+  if (method == "dla") {
+    DlaOptions opt;
+    opt.tolerance = tol;
+    if (sc["discretization"] == "alpha") {
+      DlaStepper<S, AlphaDiscretization> st(sys, AlphaDiscretization{alpha}, h, opt);
+      rep = integrate_dla(st, q0, v0, steps, rec);
+    } else {
+      DlaStepper<S, SymmetricDiscretization> st(sys, SymmetricDiscretization{alpha}, h, opt);
+      rep = integrate_dla(st, q0, v0, steps, rec);
+    }
+  } else if (method == "rk4") {
+    rep = integrate_rk4(Rk4Stepper<S>(sys, h), q0, v0, steps, rec);
+  } else {
+    BenchmarkOptions opt;
+    opt.rtol = opt.atol = tol;
+    rep = integrate_benchmark(sys, h, q0, v0, steps, opt, rec);
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  const double cpu = cpu_seconds() - cpu0;
+
+  json out;
+  out["scene"] = sc;
+  out["status"] = rep.ok ? "ok" : "failed";
+  if (!rep.ok) out["failure"] = {{"step", rep.failure_step}, {"time", rep.failure_step * h},
+                                 {"reason", rep.reason}};
+  rec.write(&out);
+  out["stats"] = {{"wall_seconds", wall},
+                  {"cpu_seconds", cpu},
+                  {"steps_taken", rep.steps_taken},
+                  {"newton_iterations", rep.newton_iterations},
+                  {"residual_evaluations", rep.residual_evaluations},
+                  {"fallback_steps", rep.fallbacks},
+                  {"rhs_evaluations", rep.rhs_evaluations},
+                  {"internal_steps", rep.internal_steps}};
+  out["meta"] = meta();
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> system_names() { return {"particle"}; }
+
+json load_scene_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw SceneError("cannot read scene file '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  try {
+    return json::parse(ss.str());
+  } catch (const json::parse_error& e) {
+    throw SceneError("scene file '" + path + "' is not valid JSON: " + e.what());
+  }
+}
+
+void apply_override(json* scene, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw SceneError("--set expects key=value, got '" + assignment + "'");
+  const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  json value;
+  try {
+    value = json::parse(text);
+  } catch (const json::parse_error&) {
+    value = text;
+  }
+  if (!scene->is_object()) throw SceneError("scene must be a JSON object");
+  const auto dot = key.find('.');
+  if (dot == std::string::npos) {
+    (*scene)[key] = value;
+  } else {
+    const std::string head = key.substr(0, dot), tail = key.substr(dot + 1);
+    if (head != "params" || tail.empty() || tail.find('.') != std::string::npos)
+      throw SceneError("--set: only params.NAME may be dotted, got '" + key + "'");
+    if (!scene->contains("params")) (*scene)["params"] = json::object();
+    if (!(*scene)["params"].is_object()) fail("params", "must be an object");
+    (*scene)["params"][tail] = value;
+  }
+}
+
+json validate_scene(const json& scene) {
+  if (!scene.is_object()) throw SceneError("scene must be a JSON object, got " + show(scene));
+  for (const auto& [key, value] : scene.items())
+    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end())
+      fail(key, "unknown key");
+  for (const char* key : {"system", "q0", "v0", "method", "h", "steps"})
+    if (!scene.contains(key)) fail(key, "missing (required)");
+
+  json r;
+  r["system"] = one_of(scene["system"], "system", system_names());
+  if (scene.contains("params") && !scene["params"].is_object())
+    fail("params", "must be an object, got " + show(scene["params"]));
+  r["method"] = one_of(scene["method"], "method", {"dla", "rk4", "benchmark"});
+  r["discretization"] = scene.contains("discretization")
+                            ? one_of(scene["discretization"], "discretization", {"alpha", "symmetric"})
+                            : "alpha";
+  const double alpha = scene.contains("alpha") ? finite_number(scene["alpha"], "alpha") : 0.5;
+  if (!(alpha >= 0.0 && alpha <= 1.0)) fail("alpha", "must be in [0, 1], got " + show(scene["alpha"]));
+  r["alpha"] = alpha;
+  const double h = finite_number(scene["h"], "h");
+  if (!(h > 0)) fail("h", "must be > 0, got " + show(scene["h"]));
+  r["h"] = h;
+  r["steps"] = integer(scene["steps"], "steps", 1, 10'000'000'000L);
+  const double tol = scene.contains("tolerance") ? finite_number(scene["tolerance"], "tolerance") : 1e-12;
+  if (!(tol > 0 && tol < 1)) fail("tolerance", "must be in (0, 1), got " + show(scene["tolerance"]));
+  r["tolerance"] = tol;
+  r["output_every"] = scene.contains("output_every")
+                          ? integer(scene["output_every"], "output_every", 1, 10'000'000'000L)
+                          : 1L;
+  if (!std::isfinite(h * double(r["steps"].get<long>())))
+    fail("h", "h * steps is not finite");
+
+  json params;
+  with_system(scene, &params, [&](const auto& sys) {
+    using S = std::decay_t<decltype(sys)>;
+    constexpr int n = S::n;
+    const Vec<double, n> q0 = vector_of<n>(scene["q0"], "q0");
+    const Vec<double, n> v0 = vector_of<n>(scene["v0"], "v0");
+    // v0 must lie in the constraint distribution, to a relative 1e-9 of the
+    // size of the terms of omega(q0) v0 (a hand-typed decimal passes, a wrong
+    // velocity does not).
+    const auto W = sys.template omega<double>(q0);
+    for (int a = 0; a < S::m; ++a) {
+      const double c = W.row(a).dot(v0);
+      const double scale = (W.row(a).cwiseAbs() * v0.cwiseAbs()).sum();
+      if (!(std::abs(c) <= 1e-9 * std::max(scale, 1e-300) || c == 0.0)) {
+        std::ostringstream os;
+        os << "violates constraint " << a << ": omega(q0) v0 = " << c
+           << " (allowed: 1e-9 relative to " << scale << ")";
+        fail("v0", os.str());
+      }
+    }
+    r["q0"] = to_json(q0);
+    r["v0"] = to_json(v0);
+    return 0;
+  });
+  r["params"] = params;
+  return r;
+}
+
+json run_scene(const json& resolved) {
+  json params;
+  return with_system(resolved, &params, [&](const auto& sys) { return run_system(sys, resolved); });
+}
+
+}  // namespace nhi

@@ -1,0 +1,132 @@
+// The `nhi run` command line, driven as a user (or an outside check) drives it:
+// exit codes, one-line errors, result files whole or absent.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+struct Result {
+  int code;
+  std::string err;
+};
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("nhi_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  Result run(const std::string& args) const {
+    const std::string err = path("stderr.txt");
+    const int status = std::system((std::string(NHI_BINARY) + " " + args + " 2> " + err).c_str());
+    std::ifstream in(err);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+  }
+  static std::string scene() { return std::string(NHI_SCENES) + "/particle.json"; }
+  fs::path dir_;
+};
+
+TEST_F(Cli, RunWritesTheResultContract) {
+  const std::string out = path("r.json");
+  const Result r = run("run " + scene() + " --set steps=20 -o " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(std::ifstream(out));
+  EXPECT_EQ(j["status"], "ok");
+  for (const char* k : {"scene", "t", "q", "v", "energy", "constraint", "p", "lambda", "stats", "meta", "summary"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["t"].size(), 21u);
+  EXPECT_EQ(j["q"][20].size(), 3u);
+  EXPECT_EQ(j["constraint"][0].size(), 1u);
+  EXPECT_EQ(j["scene"]["steps"], 20);
+  EXPECT_TRUE(j["meta"].contains("git_revision"));
+  EXPECT_TRUE(j["stats"].contains("newton_iterations"));
+  EXPECT_TRUE(j["stats"].contains("cpu_seconds"));
+}
+
+TEST_F(Cli, EveryMethodRuns) {
+  for (const char* m : {"dla", "rk4", "benchmark"}) {
+    const std::string out = path(std::string(m) + ".json");
+    const Result r = run("run " + scene() + " --set method=" + m + " --set steps=5 -o " + out);
+    ASSERT_EQ(r.code, 0) << m << ": " << r.err;
+    const json j = json::parse(std::ifstream(out));
+    EXPECT_EQ(j["t"].size(), 6u) << m;
+    EXPECT_EQ(j.contains("p"), std::string(m) == "dla");
+  }
+}
+
+TEST_F(Cli, BadInputsFailWithOneLineAndNoFile) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {write("trunc.json", R"({"system": "particle", "q0": [1, 0.5)"), ""},
+      {write("notobj.json", "[1, 2, 3]"), ""},
+      {scene(), "--set system=pendulum"},
+      {scene(), "--set method=euler"},
+      {scene(), "--set 'q0=[1,2]'"},
+      {scene(), "--set alpha=1.5"},
+      {scene(), "--set h=0"},
+      {scene(), "--set steps=0"},
+      {scene(), "--set steps=2.5"},
+      {scene(), "--set h=1e400"},
+      {scene(), "--set 'v0=[0.5,1,1]'"},
+      {scene(), "--set colour=3"},
+      {path("missing.json"), ""},
+  };
+  const std::string out = path("out.json");
+  std::ofstream(out) << "precious";
+  for (const auto& [file, extra] : cases) {
+    const Result r = run("run " + file + " " + extra + " -o " + out);
+    EXPECT_EQ(r.code, 2) << file << " " << extra << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("nhi: error:"), std::string::npos) << r.err;
+    std::ifstream in(out);
+    std::string text;
+    std::getline(in, text);
+    EXPECT_EQ(text, "precious") << "output clobbered by " << file << " " << extra;
+  }
+  // Nothing else was left in the directory (no temporary files).
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    const std::string name = e.path().filename().string();
+    EXPECT_TRUE(name == "out.json" || name == "stderr.txt" || name.size() > 5) << name;
+    EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+  }
+}
+
+TEST_F(Cli, OutputPathThatIsADirectoryOrUnwritableFails) {
+  EXPECT_EQ(run("run " + scene() + " -o " + dir_.string()).code, 2);
+  EXPECT_EQ(run("run " + scene() + " -o " + path("no/such/dir/r.json")).code, 2);
+}
+
+TEST_F(Cli, UnconvergedStepEndsTheRunAsFailedAndKeepsTheTrajectory) {
+  // A tolerance below round-off cannot be met: the very first solve fails,
+  // through Newton and the TinySolver fallback, and the run says so.
+  const std::string out = path("f.json");
+  const Result r = run("run " + scene() + " --set tolerance=1e-30 -o " + out);
+  EXPECT_EQ(r.code, 3) << r.err;
+  const json j = json::parse(std::ifstream(out));
+  EXPECT_EQ(j["status"], "failed");
+  EXPECT_EQ(j["failure"]["step"], 1);
+  EXPECT_NE(j["failure"]["reason"].get<std::string>().find("did not converge"), std::string::npos);
+  // A DLA point k is complete (lambda_k, v_k) only once q_{k+1} is known: none is.
+  EXPECT_EQ(j["t"].size(), 0u);
+}
+
+}  // namespace

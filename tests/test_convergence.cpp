@@ -1,0 +1,94 @@
+// Convergence orders against the CVODE benchmark (CI's convergence-order
+// tests): the global error in q at T over a halving sequence of h, and the
+// least-squares slope of log error against log h above the round-off floor.
+// Section 4 of the paper: second order for alpha = 1/2 and for the symmetric
+// family.  The alpha != 1/2 discretizations are first order: see README.md
+// ("Convergence") for the run that isolates why.
+#include "scenes.hpp"
+
+namespace nhi::test {
+namespace {
+
+template <class S>
+class ConvergenceTest : public ::testing::Test {};
+TYPED_TEST_SUITE(ConvergenceTest, Systems);
+
+constexpr double kT = 4.0;
+
+template <class S>
+Vec<double, S::n> reference(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0) {
+  Vec<double, S::n> q, v;
+  BenchmarkOptions opt;
+  opt.rtol = opt.atol = 1e-13;
+  integrate_benchmark(sys, kT, q0, v0, 1, opt, [&](const Sample<S::n, S::m>& s) {
+    q = s.q;
+    return true;
+  });
+  return q;
+}
+
+template <class S, class Run>
+double order_of(Run&& run_to_T) {
+  const S sys = make_system<S>();
+  std::mt19937 rng(21);
+  Vec<double, S::n> q0, v0;
+  random_state<S>(rng, &q0, &v0);
+  const Vec<double, S::n> qref = reference(sys, q0, v0);
+  std::vector<double> hs, errs;
+  for (double h = 0.2; h > 0.006; h /= 2) {
+    const Vec<double, S::n> q = run_to_T(sys, q0, v0, h, std::lround(kT / h));
+    const double e = (q - qref).cwiseAbs().maxCoeff();
+    if (e > 1e-10) {  // above the round-off / benchmark floor
+      hs.push_back(h);
+      errs.push_back(e);
+    }
+  }
+  EXPECT_GE(hs.size(), 3u) << "too few points above the floor to fit an order";
+  return fitted_order(hs, errs);
+}
+
+template <class S, class D>
+double dla_order(const D& disc) {
+  return order_of<S>([&](const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+                         double h, long steps) {
+    Vec<double, S::n> q;
+    DlaStepper<S, D> st(sys, disc, h);
+    const RunReport rep = integrate_dla(st, q0, v0, steps, [&](const Sample<S::n, S::m>& s) {
+      q = s.q;
+      return true;
+    });
+    EXPECT_TRUE(rep.ok) << rep.reason;
+    return q;
+  });
+}
+
+TYPED_TEST(ConvergenceTest, MidpointDlaIsSecondOrder) {
+  EXPECT_NEAR(dla_order<TypeParam>(AlphaDiscretization{0.5}), 2.0, 0.1);
+}
+
+TYPED_TEST(ConvergenceTest, SymmetricDlaIsSecondOrder) {
+  for (double a : {0.0, 0.25})
+    EXPECT_NEAR(dla_order<TypeParam>(SymmetricDiscretization{a}), 2.0, 0.1) << "alpha " << a;
+}
+
+TYPED_TEST(ConvergenceTest, AlphaDlaOffMidpointIsFirstOrder) {
+  for (double a : {0.0, 0.25, 0.75, 1.0})
+    EXPECT_NEAR(dla_order<TypeParam>(AlphaDiscretization{a}), 1.0, 0.15) << "alpha " << a;
+}
+
+TYPED_TEST(ConvergenceTest, Rk4IsFourthOrder) {
+  using S = TypeParam;
+  const double p = order_of<S>([](const S& sys, const Vec<double, S::n>& q0,
+                                  const Vec<double, S::n>& v0, double h, long steps) {
+    Vec<double, S::n> q;
+    integrate_rk4(Rk4Stepper<S>(sys, h), q0, v0, steps, [&](const Sample<S::n, S::m>& s) {
+      q = s.q;
+      return true;
+    });
+    return q;
+  });
+  EXPECT_NEAR(p, 4.0, 0.2);
+}
+
+}  // namespace
+}  // namespace nhi::test

@@ -1,0 +1,102 @@
+// The DLA step (eq. 6) itself: every step solves its equations to round-off and
+// keeps the discrete constraint (eq. 13/14) to round-off; with no constraints
+// the DLA is the variational integrator of its discrete Lagrangian.
+#include "scenes.hpp"
+
+namespace nhi::test {
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+template <class S>
+class DlaTest : public ::testing::Test {};
+TYPED_TEST_SUITE(DlaTest, Systems);
+
+// Run `steps` DLA steps by hand and return the worst relative residual of
+// eq. (6) and the worst relative discrete-constraint value.
+template <class S, class D>
+std::pair<double, double> worst_residuals(const D& disc, double h, long steps) {
+  constexpr int n = S::n, m = S::m;
+  const S sys = make_system<S>();
+  std::mt19937 rng(11);
+  Vec<double, n> q, v;
+  random_state<S>(rng, &q, &v);
+  DlaStepper<S, D> st(sys, disc, h);
+  Vec<double, n> p = momentum(sys, q, v), guess = q + h * v, q_next, p_next;
+  Vec<double, m> lambda = Vec<double, m>::Zero();
+  double worst_r = 0, worst_c = 0;
+  for (long k = 0; k < steps; ++k) {
+    const StepSummary s = st.step(q, p, guess, &q_next, &lambda, &p_next);
+    EXPECT_EQ(s.status, SolveStatus::kConverged) << s.message;
+    if (s.status != SolveStatus::kConverged) break;
+    worst_r = std::max(worst_r, st.relative_residual(q, p, q_next, lambda));
+    Vec<double, m> scale;
+    const Vec<double, m> wd = discrete_constraint<S, D, double>(sys, disc, h, q, q_next, &scale);
+    for (int a = 0; a < m; ++a) {
+      // Judge against the size of the terms, including round-off in (q1 - q0)/h.
+      const double floor = scale[a] + sys.template omega<double>(q).row(a).cwiseAbs().dot(
+                                          (q.cwiseAbs() + q_next.cwiseAbs())) / h;
+      worst_c = std::max(worst_c, std::abs(wd[a]) / floor);
+    }
+    guess = q_next + (q_next - q);
+    q = q_next;
+    p = p_next;
+  }
+  return {worst_r, worst_c};
+}
+
+TYPED_TEST(DlaTest, StepResidualAndDiscreteConstraintAtRoundOff) {
+  for (double h : {0.2, 0.02}) {
+    for (double a : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+      const auto [r, c] = worst_residuals<TypeParam>(AlphaDiscretization{a}, h, 400);
+      EXPECT_LE(r, 64 * kEps) << "alpha " << a << " h " << h;
+      EXPECT_LE(c, 64 * kEps) << "alpha " << a << " h " << h;
+    }
+    for (double a : {0.0, 0.25}) {
+      const auto [r, c] = worst_residuals<TypeParam>(SymmetricDiscretization{a}, h, 400);
+      EXPECT_LE(r, 64 * kEps) << "symmetric alpha " << a << " h " << h;
+      EXPECT_LE(c, 64 * kEps) << "symmetric alpha " << a << " h " << h;
+    }
+  }
+}
+
+// With no constraints eq. (6) is the discrete Euler-Lagrange equation (2).  For
+// L = v^2/2 - k q^2/2 and L_d^alpha it reads q_{k+1} - 2 c q_k + q_{k-1} = 0 with
+//   2c = (2/h - h k (a^2 + (1-a)^2)) / (1/h + h k a (1-a)),
+// so q_k = q_0 cos(k th) + B sin(k th), cos th = c, B from q_1.
+TEST(DlaVariational, UnconstrainedDlaIsTheVariationalIntegratorInClosedForm) {
+  const Oscillator osc{2.0};
+  for (double a : {0.0, 0.3, 0.5, 1.0}) {
+    const double h = 0.3, k = osc.k;
+    const double c = 0.5 * (2 / h - h * k * (a * a + (1 - a) * (1 - a))) / (1 / h + h * k * a * (1 - a));
+    ASSERT_LT(std::abs(c), 1.0);
+    const double th = std::acos(c);
+    DlaStepper<Oscillator, AlphaDiscretization> st(osc, AlphaDiscretization{a}, h);
+    Vec<double, 1> q0(0.7), v0(-0.4);
+    std::vector<double> qs;
+    const RunReport rep = integrate_dla(st, q0, v0, 2000, [&](const Sample<1, 0>& s) {
+      qs.push_back(s.q[0]);
+      return true;
+    });
+    ASSERT_TRUE(rep.ok) << rep.reason;
+    const double B = (qs[1] - qs[0] * std::cos(th)) / std::sin(th);
+    double worst = 0;
+    for (size_t j = 0; j < qs.size(); ++j)
+      worst = std::max(worst, std::abs(qs[j] - (qs[0] * std::cos(j * th) + B * std::sin(j * th))));
+    EXPECT_LT(worst, 1e-11) << "alpha " << a;
+    // The first step is the discrete Legendre transform p_0 = -D1 L_d(q_0, q_1).
+    const double q1 = qs[1], v = (q1 - qs[0]) / h, qa = (1 - a) * qs[0] + a * q1;
+    EXPECT_NEAR(v0[0], v + h * (1 - a) * k * qa, 1e-14);
+  }
+}
+
+TEST(DlaTraits, MethodsKnowTheirOrder) {
+  EXPECT_EQ(AlphaDiscretization{0.5}.order(), 2);
+  EXPECT_TRUE(AlphaDiscretization{0.5}.symmetric());
+  EXPECT_FALSE(AlphaDiscretization{0.25}.symmetric());
+  EXPECT_EQ(SymmetricDiscretization{0.0}.order(), 2);
+  EXPECT_EQ(Rk4Stepper<Particle>::order(), 4);
+}
+
+}  // namespace
+}  // namespace nhi::test

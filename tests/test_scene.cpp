@@ -1,0 +1,114 @@
+// Scene validation (the runner's input contract): every bad input is one clear
+// SceneError naming the key; a good scene resolves with its defaults.
+#include <gtest/gtest.h>
+
+#include "nhi/scene.hpp"
+
+namespace nhi {
+namespace {
+
+json good() {
+  return json::parse(R"({"system": "particle", "q0": [1, 0.5, 0], "v0": [0.5, 1, 0.25],
+                         "method": "dla", "h": 0.2, "steps": 10})");
+}
+
+TEST(Scene, ResolvesDefaults) {
+  const json r = validate_scene(good());
+  EXPECT_EQ(r["discretization"], "alpha");
+  EXPECT_EQ(r["alpha"], 0.5);
+  EXPECT_EQ(r["tolerance"], 1e-12);
+  EXPECT_EQ(r["output_every"], 1);
+  EXPECT_EQ(r["params"]["kx"], 1.0);
+  EXPECT_EQ(r["params"]["ky"], 1.0);
+}
+
+struct Bad {
+  const char* what;
+  const char* key;       // the key the message must name
+  std::function<void(json&)> edit;
+};
+
+TEST(Scene, RejectsBadInputNamingTheKey) {
+  const std::vector<Bad> cases = {
+      {"unknown system", "system", [](json& s) { s["system"] = "pendulum"; }},
+      {"unknown method", "method", [](json& s) { s["method"] = "euler"; }},
+      {"unknown discretization", "discretization", [](json& s) { s["discretization"] = "trapezoid"; }},
+      {"q0 too short", "q0", [](json& s) { s["q0"] = {1, 2}; }},
+      {"v0 too long", "v0", [](json& s) { s["v0"] = {0, 0, 0, 0}; }},
+      {"q0 not an array", "q0", [](json& s) { s["q0"] = 3; }},
+      {"q0 entry a string", "q0[1]", [](json& s) { s["q0"] = {1, "a", 0}; }},
+      {"alpha above 1", "alpha", [](json& s) { s["alpha"] = 1.0000001; }},
+      {"alpha below 0", "alpha", [](json& s) { s["alpha"] = -1e-9; }},
+      {"h zero", "h", [](json& s) { s["h"] = 0; }},
+      {"h negative", "h", [](json& s) { s["h"] = -0.1; }},
+      {"h infinite", "h", [](json& s) { s["h"] = std::numeric_limits<double>::infinity(); }},
+      {"steps zero", "steps", [](json& s) { s["steps"] = 0; }},
+      {"steps zero (unsigned)", "steps", [](json& s) { s["steps"] = 0u; }},
+      {"output_every zero (parsed)", "output_every", [](json& s) { s["output_every"] = json::parse("0"); }},
+      {"steps negative", "steps", [](json& s) { s["steps"] = -5; }},
+      {"steps fractional", "steps", [](json& s) { s["steps"] = 1.5; }},
+      {"steps a string", "steps", [](json& s) { s["steps"] = "10"; }},
+      {"v0 off the constraint", "v0", [](json& s) { s["v0"] = {0.5, 1, 0.3}; }},
+      {"unknown key", "stepz", [](json& s) { s["stepz"] = 3; }},
+      {"missing method", "method", [](json& s) { s.erase("method"); }},
+      {"missing h", "h", [](json& s) { s.erase("h"); }},
+      {"unknown parameter", "params.mass", [](json& s) { s["params"] = {{"mass", 2}}; }},
+      {"params not an object", "params", [](json& s) { s["params"] = {1, 2}; }},
+      {"tolerance zero", "tolerance", [](json& s) { s["tolerance"] = 0; }},
+      {"output_every zero", "output_every", [](json& s) { s["output_every"] = 0; }},
+      {"NaN entry", "v0[0]", [](json& s) { s["v0"][0] = std::nan(""); }},
+  };
+  for (const auto& c : cases) {
+    json s = good();
+    c.edit(s);
+    try {
+      validate_scene(s);
+      ADD_FAILURE() << c.what << ": accepted";
+    } catch (const SceneError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(std::string("'") + c.key + "'"), std::string::npos)
+          << c.what << ": message does not name '" << c.key << "': " << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << c.what << ": not one line";
+    }
+  }
+}
+
+TEST(Scene, OverridesParseJsonOrFallBackToString) {
+  json s = good();
+  apply_override(&s, "alpha=0.25");
+  apply_override(&s, "q0=[2,0,0]");
+  apply_override(&s, "method=rk4");
+  apply_override(&s, "params.ky=3");
+  EXPECT_EQ(s["alpha"], 0.25);
+  EXPECT_EQ(s["q0"], json::parse("[2,0,0]"));
+  EXPECT_EQ(s["method"], "rk4");
+  EXPECT_EQ(s["params"]["ky"], 3);
+  EXPECT_THROW(apply_override(&s, "novalue"), SceneError);
+}
+
+TEST(Scene, RunRecordsEveryPointAndTheSummary) {
+  json s = good();
+  s["steps"] = 7;
+  s["output_every"] = 3;
+  const json r = run_scene(validate_scene(s));
+  ASSERT_EQ(r["status"], "ok");
+  // Points 0, 3, 6 and the last one, 7.
+  ASSERT_EQ(r["t"].size(), 4u);
+  EXPECT_DOUBLE_EQ(r["t"][3].get<double>(), 7 * 0.2);
+  EXPECT_EQ(r["q"].size(), 4u);
+  EXPECT_EQ(r["p"].size(), 4u);
+  EXPECT_EQ(r["lambda"][0].size(), 1u);
+  // The summary's maxima cover every point, the recorded ones included.
+  double recorded = 0;
+  for (const auto& e : r["energy"]) recorded = std::max(recorded, std::abs(e.get<double>() - r["energy"][0].get<double>()));
+  EXPECT_GE(r["summary"]["max_abs_energy_error"].get<double>(), recorded);
+  // Same run at stride 1: the summary is identical.
+  s["output_every"] = 1;
+  const json full = run_scene(validate_scene(s));
+  EXPECT_EQ(full["t"].size(), 8u);
+  EXPECT_EQ(full["summary"]["max_abs_energy_error"], r["summary"]["max_abs_energy_error"]);
+  EXPECT_EQ(full["summary"]["max_abs_constraint"], r["summary"]["max_abs_constraint"]);
+}
+
+}  // namespace
+}  // namespace nhi
