@@ -4,6 +4,8 @@
 // Section 4 of the paper: second order for alpha = 1/2 and for the symmetric
 // family.  The alpha != 1/2 discretizations are first order: see README.md
 // ("Convergence") for the run that isolates why.
+#include <cstdio>
+
 #include "scenes.hpp"
 
 namespace nhi::test {
@@ -44,7 +46,10 @@ double order_of(Run&& run_to_T) {
     }
   }
   EXPECT_GE(hs.size(), 3u) << "too few points above the floor to fit an order";
-  return fitted_order(hs, errs);
+  const double p = fitted_order(hs, errs);
+  std::printf("    fitted order %.3f over h = %g..%g (errors %.2e..%.2e)\n", p, hs.front(), hs.back(),
+              errs.front(), errs.back());
+  return p;
 }
 
 template <class S, class D>

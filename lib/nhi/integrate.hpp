@@ -27,6 +27,7 @@ struct Sample {
   bool has_p = false;  // DLA only: p_k = D2 L_d(q_{k-1}, q_k), lambda_k of the step k -> k+1
   Vec<double, n> p = Vec<double, n>::Zero();
   Vec<double, m> lambda = Vec<double, m>::Zero();
+  Vec<double, m> discrete_constraint = Vec<double, m>::Zero();  // DLA: omega_d(q_k, q_{k+1})
 };
 
 struct RunReport {
@@ -87,6 +88,8 @@ RunReport integrate_dla(const DlaStepper<S, D>& stepper, const Vec<double, S::n>
     s.v = (k == 0) ? v0 : Vec<double, n>((q_next - q_prev) / (2 * h));
     s.p = p_curr;
     s.lambda = lambda;
+    s.discrete_constraint = discrete_constraint<S, D, double>(stepper.system(),
+                                                              stepper.discretization(), h, q_curr, q_next);
     if (!observe(static_cast<const Sample<n, m>&>(s))) {
       rep.fail(k, "stopped by observer");
       return rep;

@@ -41,7 +41,7 @@ class Recorder {
     return true;
   }
 
-  // Write t, q, v, energy, constraint (and p, lambda for the DLA) and summary.
+  // Write t, q, v, energy, constraint (and p, lambda, discrete_constraint for the DLA) and summary.
   void write(nlohmann::json* out) {
     flush();  // the last point reached, if it was not on the stride
     auto& o = *out;
@@ -53,6 +53,7 @@ class Recorder {
     if (has_p_) {
       o["p"] = rows(p_, n);
       o["lambda"] = rows(lambda_, m);
+      o["discrete_constraint"] = rows(wd_, m);
     }
     o["summary"] = {{"points", static_cast<long>(t_.size())},
                     {"max_abs_energy_error", max_dE_},
@@ -78,6 +79,7 @@ class Recorder {
       has_p_ = true;
       p_.insert(p_.end(), s.p.data(), s.p.data() + n);
       lambda_.insert(lambda_.end(), s.lambda.data(), s.lambda.data() + m);
+      wd_.insert(wd_.end(), s.discrete_constraint.data(), s.discrete_constraint.data() + m);
     }
   }
   static nlohmann::json rows(const std::vector<double>& flat, int width) {
@@ -94,7 +96,7 @@ class Recorder {
   double pending_E_ = 0;
   Vec<double, m> pending_c_;
   bool have_pending_ = false, has_p_ = false;
-  std::vector<double> t_, q_, v_, E_, c_, p_, lambda_;
+  std::vector<double> t_, q_, v_, E_, c_, p_, lambda_, wd_;
 };
 
 }  // namespace nhi
