@@ -13,6 +13,8 @@
 // So a discretization is a list of nodes (weight w_i, interpolation c_i) and
 //   L_d     = h sum_i w_i L(q_{c_i}, (q1-q0)/h)
 //   omega_d = sum_i w_i omega(q_{c_i}) (q1-q0)/h
+// constraint_nodes() gives the nodes of omega_d: the same as nodes(), as Remark
+// 3.1 asks; a study may pair them differently to see which half sets the order.
 #pragma once
 
 #include <array>
@@ -33,6 +35,7 @@ struct AlphaDiscretization {
   static constexpr const char* kind = "alpha";
   double alpha = 0.5;
   std::array<Node, 1> nodes() const { return {{{1.0, alpha}}}; }
+  std::array<Node, 1> constraint_nodes() const { return nodes(); }  // Remark 3.1: same discretization
   // Order of the DLA built on it for the nonholonomic problem (section 4:
   // second order guaranteed only for alpha = 1/2; tests/test_convergence.cpp
   // measures the others).
@@ -47,6 +50,7 @@ struct SymmetricDiscretization {
   static constexpr const char* kind = "symmetric";
   double alpha = 0.0;
   std::array<Node, 2> nodes() const { return {{{0.5, alpha}, {0.5, 1.0 - alpha}}}; }
+  std::array<Node, 2> constraint_nodes() const { return nodes(); }
   int order() const { return 2; }
   bool symmetric() const { return true; }
   std::string name() const { return "symmetric alpha=" + std::to_string(alpha); }
@@ -120,7 +124,7 @@ inline Vec<T, S::m> discrete_constraint(const S& sys, const D& disc, double h,
   Vec<T, S::m> w;
   w.setConstant(cst<T>(0.0));
   if (scale) scale->setZero();
-  for (const Node& nd : disc.nodes()) {
+  for (const Node& nd : disc.constraint_nodes()) {
     const Mat<T, S::m, S::n> W = sys.template omega<T>(interpolate(q0, q1, nd.c));
     w += cst<T>(nd.weight) * (W * v);
     if (scale) {

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "nhi/benchmark.hpp"
 #include "nhi/dla.hpp"
@@ -55,13 +56,16 @@ inline std::atomic<bool>& interrupt_flag() {
 
 // DLA from (q0, v0): p_0 = dL/dqdot(q_0, v_0), first guess q_0 + h v_0, then
 // q_k + (q_k - q_{k-1}).  The observer returns false to stop the run.
+// The start p_0 may also be given (integrate_dla_from), e.g. to study how the
+// choice of p_0 affects the order.
 template <class S, class D, class Observer>
-RunReport integrate_dla(const DlaStepper<S, D>& stepper, const Vec<double, S::n>& q0,
-                        const Vec<double, S::n>& v0, long steps, Observer&& observe) {
+RunReport integrate_dla_from(const DlaStepper<S, D>& stepper, const Vec<double, S::n>& q0,
+                             const Vec<double, S::n>& v0, const Vec<double, S::n>& p0,
+                             long steps, Observer&& observe) {
   constexpr int n = S::n, m = S::m;
   const double h = stepper.h();
   RunReport rep;
-  Vec<double, n> q_prev = q0, q_curr = q0, p_curr = momentum(stepper.system(), q0, v0);
+  Vec<double, n> q_prev = q0, q_curr = q0, p_curr = p0;
   Vec<double, n> q_next = q0, p_next = p_curr, guess = q0 + h * v0;
   Vec<double, m> lambda = Vec<double, m>::Zero();
   Sample<n, m> s;
@@ -100,6 +104,13 @@ RunReport integrate_dla(const DlaStepper<S, D>& stepper, const Vec<double, S::n>
     p_curr = p_next;
   }
   return rep;
+}
+
+template <class S, class D, class Observer>
+RunReport integrate_dla(const DlaStepper<S, D>& stepper, const Vec<double, S::n>& q0,
+                        const Vec<double, S::n>& v0, long steps, Observer&& observe) {
+  return integrate_dla_from(stepper, q0, v0, momentum(stepper.system(), q0, v0), steps,
+                            std::forward<Observer>(observe));
 }
 
 template <class S, class Observer>
