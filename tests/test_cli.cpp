@@ -4,6 +4,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
+
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -127,6 +129,27 @@ TEST_F(Cli, UnconvergedStepEndsTheRunAsFailedAndKeepsTheTrajectory) {
   EXPECT_NE(j["failure"]["reason"].get<std::string>().find("did not converge"), std::string::npos);
   // A DLA point k is complete (lambda_k, v_k) only once q_{k+1} is known: none is.
   EXPECT_EQ(j["t"].size(), 0u);
+}
+
+TEST_F(Cli, InterruptedRunWritesNothing) {
+  const std::string out = path("i.json");
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string sc = scene();
+    ::execl(NHI_BINARY, NHI_BINARY, "run", sc.c_str(), "--set", "steps=2000000000", "--set",
+            "output_every=100000000", "-o", out.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::usleep(300000);  // the run is under way (it would take minutes)
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
 }
 
 }  // namespace

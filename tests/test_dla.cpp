@@ -22,7 +22,7 @@ std::pair<double, double> worst_residuals(const D& disc, double h, long steps) {
   Vec<double, n> q, v;
   random_state<S>(rng, &q, &v);
   DlaStepper<S, D> st(sys, disc, h);
-  Vec<double, n> p = momentum(sys, q, v), guess = q + h * v, q_next, p_next;
+  Vec<double, n> p = momentum(sys, q, v), guess = q + h * v, q_next = q, p_next = p;
   Vec<double, m> lambda = Vec<double, m>::Zero();
   double worst_r = 0, worst_c = 0;
   for (long k = 0; k < steps; ++k) {
