@@ -210,7 +210,6 @@ class DlaStepper {
 
   // The same residual for ceres::TinySolverAutoDiffFunction (all N unknowns).
   struct Functor {
-    using Scalar = double;
     enum { NUM_RESIDUALS = N, NUM_PARAMETERS = N };
     const DlaStepper* self;
     const VecN* q_curr;
