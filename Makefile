@@ -32,20 +32,27 @@ test: build
 reproduce: build
 	$(MAKE) -j$(JOBS) figures
 
-# ---- Paper Figures 1-2: the nonholonomic particle at h = 0.2 ----------------
-PARTICLE_FIG12 := $(foreach m,dla rk4 benchmark,results/particle_fig12_$(m).json)
-FIGURES := plots/fig1_particle_energy.png plots/fig2_particle_constraint.png
+# ---- Paper Figures 1-4: particle (1-2) and robot (3-4) at h = 0.2 -----------
+RUNS := $(foreach s,particle_fig12 robot_fig34,$(foreach m,dla rk4 benchmark,results/$(s)_$(m).json))
+FIGURES := plots/fig1_particle_energy.png plots/fig2_particle_constraint.png \
+           plots/fig3_robot_energy.png plots/fig4_robot_constraint.png
 
 figures: $(FIGURES)
 
-results/particle_fig12_%.json: experiments/scenes/particle_fig12.json $(NHI)
-	$(NHI) run $< --set method=$* -o $@
+# results/SCENE_METHOD.json from experiments/scenes/SCENE.json
+.SECONDEXPANSION:
+$(RUNS): results/%.json: experiments/scenes/$$(word 1,$$(subst _, ,$$*))_$$(word 2,$$(subst _, ,$$*)).json $(NHI)
+	$(NHI) run $< --set method=$(lastword $(subst _, ,$*)) -o $@
 
-plots/fig1_particle_energy.png: plots/fig1_particle_energy.gp plots/style.gp $(PARTICLE_FIG12)
-	gnuplot $<
-
-plots/fig2_particle_constraint.png: plots/fig2_particle_constraint.gp plots/style.gp $(PARTICLE_FIG12)
-	gnuplot $<
+PLOT = gnuplot -e "stem='$(1)'; out='$@'; label='$(2)'; m=$(3)" $<
+plots/fig1_particle_energy.png: plots/energy.gp plots/style.gp $(filter results/particle_fig12_%,$(RUNS))
+	$(call PLOT,results/particle_fig12,Figure 1: nonholonomic particle,1)
+plots/fig2_particle_constraint.png: plots/constraint.gp plots/style.gp $(filter results/particle_fig12_%,$(RUNS))
+	$(call PLOT,results/particle_fig12,Figure 2: nonholonomic particle,1)
+plots/fig3_robot_energy.png: plots/energy.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS))
+	$(call PLOT,results/robot_fig34,Figure 3: mobile robot,2)
+plots/fig4_robot_constraint.png: plots/constraint.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS))
+	$(call PLOT,results/robot_fig34,Figure 4: mobile robot,2)
 
 clean:
 	rm -rf $(BUILD)

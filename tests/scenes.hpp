@@ -8,11 +8,12 @@
 
 #include "nhi/integrate.hpp"
 #include "nhi/systems/particle.hpp"
+#include "nhi/systems/robot.hpp"
 
 namespace nhi::test {
 
 // Every scene the library has; typed tests run on each.
-using Systems = ::testing::Types<Particle>;
+using Systems = ::testing::Types<Particle, Robot>;
 
 template <class S>
 S make_system() {

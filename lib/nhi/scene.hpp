@@ -1,7 +1,7 @@
 // Scenes in, results out: the JSON contract of the `nhi` runner.
 //
 // A scene is a JSON object with the keys
-//   system         "particle"                                   (required)
+//   system         "particle" | "robot"                         (required)
 //   params         object of system parameters                  (default: the system's)
 //   q0, v0         arrays of n numbers; v0 must satisfy omega(q0) v0 = 0   (required)
 //   method         "dla" | "rk4" | "benchmark"                   (required)

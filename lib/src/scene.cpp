@@ -11,6 +11,7 @@
 #include "nhi/integrate.hpp"
 #include "nhi/observer.hpp"
 #include "nhi/systems/particle.hpp"
+#include "nhi/systems/robot.hpp"
 
 namespace nhi {
 namespace {
@@ -101,12 +102,32 @@ struct SceneTraits<Particle> {
   }
 };
 
+template <>
+struct SceneTraits<Robot> {
+  static Robot make(const json& params, json* resolved) {
+    Robot r;
+    for (const auto& [key, value] : params.items()) {
+      const std::string k = "params." + key;
+      if (key == "m") r.mass = finite_number(value, k);
+      else if (key == "I") r.I = finite_number(value, k);
+      else if (key == "Iw") r.Iw = finite_number(value, k);
+      else if (key == "R") r.R = finite_number(value, k);
+      else if (key == "V0") r.V0 = finite_number(value, k);
+      else fail(k, "unknown parameter for system \"robot\" (known: m, I, Iw, R, V0)");
+      if (key != "V0" && !(value.get<double>() > 0)) fail(k, "must be > 0, got " + show(value));
+    }
+    *resolved = {{"m", r.mass}, {"I", r.I}, {"Iw", r.Iw}, {"R", r.R}, {"V0", r.V0}};
+    return r;
+  }
+};
+
 // Call f(system) with the concrete system type named in the scene.
 template <class F>
 auto with_system(const json& scene, json* resolved_params, F&& f) {
   const std::string name = scene.at("system").get<std::string>();
   const json params = scene.contains("params") ? scene.at("params") : json::object();
   if (name == "particle") return f(SceneTraits<Particle>::make(params, resolved_params));
+  if (name == "robot") return f(SceneTraits<Robot>::make(params, resolved_params));
   fail("system", "unknown system \"" + name + "\"");
 }
 
@@ -173,7 +194,7 @@ json run_system(const S& sys, const json& sc) {
 
 }  // namespace
 
-std::vector<std::string> system_names() { return {"particle"}; }
+std::vector<std::string> system_names() { return {"particle", "robot"}; }
 
 json load_scene_file(const std::string& path) {
   std::ifstream in(path);

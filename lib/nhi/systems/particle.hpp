@@ -17,8 +17,6 @@
 // about 22 periods of the y oscillation (period pi/sqrt(2)).
 #pragma once
 
-#include <array>
-
 #include "nhi/core.hpp"
 
 namespace nhi {
@@ -55,12 +53,6 @@ struct Particle {
     const double lambda = (v[0] * v[1] - 2.0 * kx * q[0] * y) / (1.0 + y * y);
     return {-2.0 * kx * q[0] - y * lambda, -2.0 * ky * y, lambda};
   }
-
-  // Defaults of the scene (documented above and in README.md).
-  static std::array<double, 3> default_q0() { return {1.0, 0.5, 0.0}; }
-  static std::array<double, 3> default_v0() { return {0.5, 1.0, 0.25}; }
-  static constexpr double default_h = 0.2;
-  static constexpr long default_steps = 500;
 };
 
 }  // namespace nhi

@@ -1,0 +1,21 @@
+# Paper Figures 1 and 3: energy along the DLA (alpha = 1/2), RK4 and the
+# benchmark at h = 0.2.  Called as
+#   gnuplot -e "stem='results/particle_fig12'; out='plots/fig1_particle_energy.png'; label='Figure 1: nonholonomic particle'" plots/energy.gp
+# reading stem_{dla,rk4,benchmark}.json.
+load "plots/style.gp"
+set output out
+dla = stem."_dla.json"
+rk4 = stem."_rk4.json"
+ref = stem."_benchmark.json"
+set multiplot layout 2,1 title label.", energy (h = 0.2)"
+set xlabel "t"
+set ylabel "E"
+set key bottom left
+plot col(dla, ".energy") u 1:2 w l ls 1 t "DLA, {/Symbol a} = 1/2", \
+     col(rk4, ".energy") u 1:2 w l ls 2 t "RK4", \
+     col(ref, ".energy") u 1:2 w l ls 3 t "benchmark (CVODE Adams, tol 1e-12)"
+set xrange [0:40]
+set title "first 40 time units"
+set key bottom right horizontal
+replot
+unset multiplot
