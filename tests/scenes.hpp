@@ -20,6 +20,18 @@ S make_system() {
   return S{};
 }
 
+// The initial state of the scene files (experiments/scenes/*.json).
+template <class S>
+void scene_state(Vec<double, S::n>* q, Vec<double, S::n>* v) {
+  if constexpr (std::is_same_v<S, Particle>) {
+    *q << 1.0, 0.5, 0.0;
+    *v << 0.5, 1.0, 0.25;
+  } else {
+    *q << 0.0, 0.0, 0.0, 0.0;
+    *v << 1.0, 0.0, 1.0, 1.0;
+  }
+}
+
 // A random configuration and a random velocity satisfying omega(q) v = 0.
 template <class S>
 void random_state(std::mt19937& rng, Vec<double, S::n>* q, Vec<double, S::n>* v) {

@@ -24,7 +24,8 @@
 // angular frequency sqrt(V0 / (3 Iw + m R^2)) = 2.24.
 #pragma once
 
-#include <array>
+#include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 
 #include "nhi/core.hpp"
@@ -74,12 +75,31 @@ struct Robot {
     return {R * (c * psidd - s * tp), R * (s * psidd + c * tp), 0.0, psidd};
   }
 
-  // The exact reduced description as a first-order ODE in y = (psi, psid, x, y),
-  // with theta(t) = theta0 + thetad0 t given: an independent formulation of
-  // the same motion, used as a second benchmark.
-  std::array<double, 4> reduced_rhs(double theta, const std::array<double, 4>& y) const {
-    const double psidd = -V0 * std::cos(y[0]) / (3.0 * Iw + mass * R * R);
-    return {y[1], psidd, R * std::cos(theta) * y[1], R * std::sin(theta) * y[1]};
+  // The exact reduced description, integrated on its own: theta(t) = theta0 +
+  // thetad0 t exactly; (psi, psid, x, y) by classical RK4 with `substeps`
+  // steps per unit time on  psidd = -V0 cos(psi) / (3 Iw + m R^2),
+  // xd = R cos(theta(t)) psid,  yd = R sin(theta(t)) psid.  A formulation that
+  // shares no code with the index-reduced ODE, used as a second benchmark.
+  void reduced_flow(const Vec<double, 4>& q0, const Vec<double, 4>& v0, double t,
+                    long substeps_per_unit, Vec<double, 4>* q, Vec<double, 4>* v) const {
+    const double k = V0 / (3.0 * Iw + mass * R * R);
+    auto rhs = [&](double tt, const Eigen::Vector4d& y) {
+      const double th = q0[2] + v0[2] * tt;
+      return Eigen::Vector4d(y[1], -k * std::cos(y[0]), R * std::cos(th) * y[1],
+                             R * std::sin(th) * y[1]);
+    };
+    Eigen::Vector4d y(q0[3], v0[3], q0[0], q0[1]);
+    const long steps = std::max(1L, static_cast<long>(std::ceil(std::abs(t) * substeps_per_unit)));
+    const double dt = t / steps;
+    for (long i = 0; i < steps; ++i) {
+      const double tt = i * dt;
+      const Eigen::Vector4d k1 = rhs(tt, y), k2 = rhs(tt + dt / 2, y + dt / 2 * k1),
+                            k3 = rhs(tt + dt / 2, y + dt / 2 * k2), k4 = rhs(tt + dt, y + dt * k3);
+      y += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    }
+    const double th = q0[2] + v0[2] * t;
+    *q << y[2], y[3], th, y[0];
+    *v << R * std::cos(th) * y[1], R * std::sin(th) * y[1], v0[2], y[1];
   }
 };
 
