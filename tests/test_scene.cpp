@@ -73,6 +73,36 @@ TEST(Scene, RejectsBadInputNamingTheKey) {
   }
 }
 
+json good_robot() {
+  return json::parse(R"({"system": "robot", "q0": [0, 0, 0, 0], "v0": [1, 0, 1, 1],
+                         "method": "dla", "h": 0.2, "steps": 10})");
+}
+
+TEST(Scene, RobotResolvesDefaultsAndRejectsBadInput) {
+  const json r = validate_scene(good_robot());
+  EXPECT_EQ(r["params"], json::parse(R"({"m": 1.0, "I": 1.0, "Iw": 0.3333333333333333, "R": 1.0, "V0": 10.0})"));
+  const std::vector<Bad> cases = {
+      {"q0 of particle length", "q0", [](json& s) { s["q0"] = {0, 0, 0}; }},
+      {"v0 too long", "v0", [](json& s) { s["v0"] = {1, 0, 1, 1, 0}; }},
+      {"v0 off the first constraint", "v0", [](json& s) { s["v0"] = {0.5, 0, 1, 1}; }},
+      {"v0 off the second constraint (turned wheels)", "v0", [](json& s) { s["q0"] = {0, 0, 1.0, 0}; }},
+      {"negative mass", "params.m", [](json& s) { s["params"] = {{"m", -1}}; }},
+      {"zero wheel radius", "params.R", [](json& s) { s["params"] = {{"R", 0}}; }},
+      {"particle parameter", "params.kx", [](json& s) { s["params"] = {{"kx", 1}}; }},
+  };
+  for (const auto& c : cases) {
+    json s = good_robot();
+    c.edit(s);
+    try {
+      validate_scene(s);
+      ADD_FAILURE() << c.what << ": accepted";
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("'") + c.key + "'"), std::string::npos)
+          << c.what << ": " << e.what();
+    }
+  }
+}
+
 TEST(Scene, OverridesParseJsonOrFallBackToString) {
   json s = good();
   apply_override(&s, "alpha=0.25");
