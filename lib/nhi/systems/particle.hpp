@@ -17,6 +17,8 @@
 // about 22 periods of the y oscillation (period pi/sqrt(2)).
 #pragma once
 
+#include <array>
+
 #include "nhi/core.hpp"
 
 namespace nhi {
@@ -25,6 +27,9 @@ struct Particle {
   static constexpr int n = 3;
   static constexpr int m = 1;
   static constexpr const char* name = "particle";
+  // Chaplygin split (reduced.hpp): shape r = (x, y), group s = z.
+  static constexpr std::array<int, 2> shape{0, 1};
+  static constexpr std::array<int, 1> group{2};
 
   double kx = 1.0;  // potential V = kx x^2 + ky y^2
   double ky = 1.0;

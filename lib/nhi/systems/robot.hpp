@@ -26,6 +26,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "nhi/core.hpp"
@@ -36,6 +37,9 @@ struct Robot {
   static constexpr int n = 4;
   static constexpr int m = 2;
   static constexpr const char* name = "robot";
+  // Chaplygin split (reduced.hpp): shape r = (theta, psi), group s = (x, y).
+  static constexpr std::array<int, 2> shape{2, 3};
+  static constexpr std::array<int, 2> group{0, 1};
 
   double mass = 1.0;  // m
   double I = 1.0;
