@@ -4,16 +4,14 @@
 // written); 2 bad input or unwritable output (nothing written); 130 interrupted
 // by SIGINT/SIGTERM (nothing written).  The output file is written to a
 // temporary file in the same directory and renamed, so it is whole or absent.
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "nhi/integrate.hpp"
+#include "nhi/output.hpp"
 #include "nhi/scene.hpp"
 
 namespace {
@@ -23,16 +21,6 @@ void on_signal(int) { nhi::interrupt_flag().store(true); }
 int error(const std::string& message, int code = 2) {
   std::cerr << "nhi: error: " << message << "\n";
   return code;
-}
-
-bool write_all(int fd, const std::string& s) {
-  size_t done = 0;
-  while (done < s.size()) {
-    const ssize_t k = ::write(fd, s.data() + done, s.size() - done);
-    if (k < 0) return false;
-    done += static_cast<size_t>(k);
-  }
-  return true;
 }
 
 }  // namespace
@@ -67,21 +55,16 @@ int main(int argc, char** argv) {
 
   // Claim the output's temporary file before running, so an unwritable path
   // fails now and not after a long run.
-  std::string tmp_path;
-  int fd = -1;
+  std::unique_ptr<nhi::AtomicFile> out;
   if (!out_path.empty()) {
-    struct stat st {};
-    if (::stat(out_path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-      return error("output '" + out_path + "' is a directory");
-    tmp_path = out_path + ".tmp." + std::to_string(::getpid());
-    fd = ::open(tmp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
-    if (fd < 0) return error("cannot write output '" + out_path + "': " + std::strerror(errno));
+    try {
+      out = std::make_unique<nhi::AtomicFile>(out_path);
+    } catch (const std::exception& e) {
+      return error(e.what());
+    }
   }
   auto discard = [&] {
-    if (fd >= 0) {
-      ::close(fd);
-      ::unlink(tmp_path.c_str());
-    }
+    if (out) out->discard();
   };
 
   std::signal(SIGINT, on_signal);
@@ -99,16 +82,13 @@ int main(int argc, char** argv) {
   }
 
   const std::string text = result.dump() + "\n";
-  if (fd < 0) {
+  if (!out) {
     std::cout << text;
   } else {
-    if (!write_all(fd, text) || ::fsync(fd) != 0 || ::close(fd) != 0) {
-      ::unlink(tmp_path.c_str());
-      return error("cannot write output '" + out_path + "': " + std::strerror(errno), 1);
-    }
-    if (std::rename(tmp_path.c_str(), out_path.c_str()) != 0) {
-      ::unlink(tmp_path.c_str());
-      return error("cannot rename to '" + out_path + "': " + std::strerror(errno), 1);
+    try {
+      out->commit(text);
+    } catch (const std::exception& e) {
+      return error(e.what(), 1);
     }
   }
   if (result["status"] != "ok") {

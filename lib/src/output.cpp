@@ -1,0 +1,52 @@
+#include "nhi/output.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+namespace nhi {
+
+AtomicFile::AtomicFile(const std::string& path) : path_(path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw std::runtime_error("output '" + path + "' is a directory");
+  tmp_ = path + ".tmp." + std::to_string(::getpid());
+  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd_ < 0) throw std::runtime_error("cannot write output '" + path + "': " + std::strerror(errno));
+}
+
+AtomicFile::~AtomicFile() { discard(); }
+
+void AtomicFile::discard() {
+  if (fd_ >= 0) {
+    ::close(fd_);
+    ::unlink(tmp_.c_str());
+    fd_ = -1;
+  }
+}
+
+void AtomicFile::commit(const std::string& text) {
+  if (fd_ < 0) throw std::runtime_error("output '" + path_ + "' already closed");
+  size_t done = 0;
+  bool ok = true;
+  while (ok && done < text.size()) {
+    const ssize_t k = ::write(fd_, text.data() + done, text.size() - done);
+    if (k < 0) ok = false;
+    else done += static_cast<size_t>(k);
+  }
+  ok = ok && ::fsync(fd_) == 0;
+  const int saved = errno;
+  ok = (::close(fd_) == 0) && ok;
+  fd_ = -1;
+  if (!ok || std::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    ::unlink(tmp_.c_str());
+    throw std::runtime_error("cannot write output '" + path_ + "': " + std::strerror(saved ? saved : errno));
+  }
+}
+
+}  // namespace nhi
