@@ -37,7 +37,9 @@ RUNS := $(foreach s,particle_fig12 robot_fig34,$(foreach m,dla rk4 benchmark,res
 FIGURES := plots/fig1_particle_energy.png plots/fig2_particle_constraint.png \
            plots/fig3_robot_energy.png plots/fig4_robot_constraint.png
 
-figures: $(FIGURES)
+STUDY_FIGURES := plots/convergence_particle.png plots/convergence_robot.png
+
+figures: $(FIGURES) $(STUDY_FIGURES)
 
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
@@ -53,6 +55,17 @@ plots/fig3_robot_energy.png: plots/energy.gp plots/style.gp $(filter results/rob
 	$(call PLOT,results/robot_fig34,Figure 3: mobile robot,2)
 plots/fig4_robot_constraint.png: plots/constraint.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS))
 	$(call PLOT,results/robot_fig34,Figure 4: mobile robot,2)
+
+# ---- Studies (issue 4): one executable, one JSON, one script each -------------
+SCENES := experiments/scenes/particle.json experiments/scenes/robot.json
+.PHONY: study-convergence
+study-convergence: plots/convergence_particle.png plots/convergence_robot.png
+
+results/convergence.json: $(BUILD)/bin/study_convergence $(SCENES)
+	$< --threads $(JOBS) -o $@
+
+plots/convergence_%.png: plots/convergence.gp plots/style.gp results/convergence.json
+	gnuplot -e "file='results/convergence.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
 
 clean:
 	rm -rf $(BUILD)

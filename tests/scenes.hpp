@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "nhi/fit.hpp"
 #include "nhi/integrate.hpp"
 #include "nhi/systems/particle.hpp"
 #include "nhi/systems/robot.hpp"
@@ -66,15 +67,8 @@ struct Oscillator {
   }
 };
 
-// Least-squares slope of log(err) against log(h).
 inline double fitted_order(const std::vector<double>& h, const std::vector<double>& err) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double N = static_cast<double>(h.size());
-  for (size_t i = 0; i < h.size(); ++i) {
-    const double x = std::log(h[i]), y = std::log(err[i]);
-    sx += x; sy += y; sxx += x * x; sxy += x * y;
-  }
-  return (N * sxy - sx * sy) / (N * sxx - sx * sx);
+  return loglog_slope(h, err);
 }
 
 }  // namespace nhi::test

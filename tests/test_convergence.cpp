@@ -87,17 +87,6 @@ TYPED_TEST(ConvergenceTest, AlphaDlaOffMidpointIsFirstOrder) {
     EXPECT_NEAR(dla_order<TypeParam>(AlphaDiscretization{a}), 1.0, 0.15) << "alpha " << a;
 }
 
-// Which half of an alpha != 1/2 discretization costs the order?  Pair L_d^a
-// with the midpoint constraint, and L_d^{1/2} with omega_d^a.
-struct SplitDiscretization {
-  static constexpr int kNodes = 1;
-  double alpha_L, alpha_omega;
-  std::array<Node, 1> nodes() const { return {{{1.0, alpha_L}}}; }
-  std::array<Node, 1> constraint_nodes() const { return {{{1.0, alpha_omega}}}; }
-  int order() const { return 0; }
-  bool symmetric() const { return false; }
-};
-
 // Two separate causes, each enough on its own to cost one order:
 //  - the start: p_0 = dL/dqdot(q_0, v_0) differs by O(h) from D2 L_d^alpha along
 //    the exact solution; with the consistent start L_d^alpha is second order

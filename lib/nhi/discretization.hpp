@@ -56,6 +56,18 @@ struct SymmetricDiscretization {
   std::string name() const { return "symmetric alpha=" + std::to_string(alpha); }
 };
 
+// For studies of what sets the order: L_d^{alpha_L} paired with
+// omega_d^{alpha_omega} (Remark 3.1 asks for alpha_L = alpha_omega).
+struct SplitDiscretization {
+  static constexpr int kNodes = 1;
+  static constexpr const char* kind = "split";
+  double alpha_L = 0.5, alpha_omega = 0.5;
+  std::array<Node, 1> nodes() const { return {{{1.0, alpha_L}}}; }
+  std::array<Node, 1> constraint_nodes() const { return {{{1.0, alpha_omega}}}; }
+  int order() const { return alpha_L == 0.5 && alpha_omega == 0.5 ? 2 : 1; }
+  bool symmetric() const { return alpha_L == 0.5 && alpha_omega == 0.5; }
+};
+
 template <class T, int N>
 inline Vec<T, N> interpolate(const Vec<T, N>& q0, const Vec<T, N>& q1, double c) {
   return cst<T>(1.0 - c) * q0 + cst<T>(c) * q1;
