@@ -37,7 +37,8 @@ RUNS := $(foreach s,particle_fig12 robot_fig34,$(foreach m,dla rk4 benchmark,res
 FIGURES := plots/fig1_particle_energy.png plots/fig2_particle_constraint.png \
            plots/fig3_robot_energy.png plots/fig4_robot_constraint.png
 
-STUDY_FIGURES := plots/convergence_particle.png plots/convergence_robot.png
+STUDY_FIGURES := plots/convergence_particle.png plots/convergence_robot.png \
+                 plots/long_horizon_particle.png plots/long_horizon_robot.png
 
 figures: $(FIGURES) $(STUDY_FIGURES)
 
@@ -66,6 +67,15 @@ results/convergence.json: $(BUILD)/bin/study_convergence $(SCENES)
 
 plots/convergence_%.png: plots/convergence.gp plots/style.gp results/convergence.json
 	gnuplot -e "file='results/convergence.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
+
+.PHONY: study-long-horizon
+study-long-horizon: plots/long_horizon_particle.png plots/long_horizon_robot.png
+
+results/long_horizon.json: $(BUILD)/bin/study_long_horizon $(SCENES)
+	$< --threads $(JOBS) -o $@
+
+plots/long_horizon_%.png: plots/long_horizon.gp plots/style.gp results/long_horizon.json
+	gnuplot -e "file='results/long_horizon.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
 
 clean:
 	rm -rf $(BUILD)
