@@ -38,7 +38,8 @@ FIGURES := plots/fig1_particle_energy.png plots/fig2_particle_constraint.png \
            plots/fig3_robot_energy.png plots/fig4_robot_constraint.png
 
 STUDY_FIGURES := plots/convergence_particle.png plots/convergence_robot.png \
-                 plots/long_horizon_particle.png plots/long_horizon_robot.png
+                 plots/long_horizon_particle.png plots/long_horizon_robot.png \
+                 plots/stability_particle.png plots/stability_robot.png
 
 figures: $(FIGURES) $(STUDY_FIGURES)
 
@@ -76,6 +77,15 @@ results/long_horizon.json: $(BUILD)/bin/study_long_horizon $(SCENES)
 
 plots/long_horizon_%.png: plots/long_horizon.gp plots/style.gp results/long_horizon.json
 	gnuplot -e "file='results/long_horizon.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
+
+.PHONY: study-stability
+study-stability: plots/stability_particle.png plots/stability_robot.png
+
+results/stability.json: $(BUILD)/bin/study_stability $(SCENES)
+	$< --threads $(JOBS) -o $@
+
+plots/stability_%.png: plots/stability.gp plots/style.gp results/stability.json
+	gnuplot -e "file='results/stability.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
 
 clean:
 	rm -rf $(BUILD)
