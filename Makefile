@@ -4,7 +4,8 @@
 # Both first install any missing Debian package (target deps).
 
 DEB_PACKAGES := cmake g++ make libeigen3-dev libceres-dev libsundials-dev \
-                nlohmann-json3-dev libcli11-dev libgtest-dev gnuplot-nox jq
+                nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev libboost-dev \
+                gnuplot-nox jq
 BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2

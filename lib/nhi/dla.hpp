@@ -157,6 +157,21 @@ class DlaStepper {
     return rel;
   }
 
+  // The residual alone (no derivatives), judged with the scale of a nearby
+  // Jacobian Jq (the one the chord iterations use): cheap.
+  double evaluate_value(const VecN& q_curr, const VecN& p_curr, const Mat<double, m, n>& W,
+                        const VecN& q1, const VecM& lambda, const Mat<double, N, n>& Jq, VecX* r) const {
+    VecX terms;
+    residual<double>(q_curr, p_curr, W, q1, lambda, r, &terms);
+    double rel = 0;
+    for (int i = 0; i < N; ++i) {
+      double scale = terms[i];
+      for (int j = 0; j < n; ++j) scale += std::abs(Jq(i, j)) * (std::abs(q_curr[j]) + std::abs(q1[j]));
+      rel = std::max(rel, ratio((*r)[i], scale));
+    }
+    return rel;
+  }
+
   static double ratio(double r, double scale) {
     if (!std::isfinite(r) || !std::isfinite(scale)) return std::numeric_limits<double>::infinity();
     if (r == 0) return 0;
@@ -175,9 +190,14 @@ class DlaStepper {
     double prev = std::numeric_limits<double>::infinity();
     VecX r;
     Mat<double, N, n> Jq;
+    Eigen::PartialPivLU<Mat<double, N, N>> lu;
+    // Newton with the Jacobian (7) refreshed only when the last step contracted
+    // the residual by less than 1e-3 (otherwise the factorization is reused):
+    // near round-off the converged iterate is the same, with fewer Jet passes.
+    bool fresh = true;  // r, Jq were just evaluated with derivatives at the iterate
+    double rel = evaluate(q_curr, p_curr, W, q1, lambda, &r, &Jq);
+    ++s.evaluations;
     for (int it = 0;; ++it) {
-      const double rel = evaluate(q_curr, p_curr, W, q1, lambda, &r, &Jq);
-      ++s.evaluations;
       s.relative_residual = rel;
       if (!std::isfinite(rel)) {
         s.message = "non-finite residual";
@@ -191,8 +211,11 @@ class DlaStepper {
                     " iterations (relative residual " + std::to_string(rel) + ")";
         return s;
       }
-      K.template leftCols<n>() = Jq;
-      const VecX dx = K.partialPivLu().solve(r);
+      if (fresh) {
+        K.template leftCols<n>() = Jq;
+        lu.compute(K);
+      }
+      const VecX dx = lu.solve(r);
       if (!dx.allFinite()) {
         s.message = "singular step matrix (eq. 7)";
         return s;
@@ -201,6 +224,14 @@ class DlaStepper {
       lambda -= dx.template tail<m>();
       prev = rel;
       ++s.iterations;
+      rel = evaluate_value(q_curr, p_curr, W, q1, lambda, Jq, &r);
+      ++s.evaluations;
+      fresh = false;
+      if (!(rel <= 1e-3 * prev) && !(rel <= kRoundoff)) {  // slow contraction: refresh the Jacobian
+        rel = evaluate(q_curr, p_curr, W, q1, lambda, &r, &Jq);
+        ++s.evaluations;
+        fresh = true;
+      }
     }
     *q_out = q1;
     *lambda_out = lambda;
