@@ -40,9 +40,10 @@ FIGURES := plots/fig1_particle_energy.png plots/fig2_particle_constraint.png \
 
 STUDY_FIGURES := plots/convergence_particle.png plots/convergence_robot.png \
                  plots/long_horizon_particle.png plots/long_horizon_robot.png \
-                 plots/stability_particle.png plots/stability_robot.png
+                 plots/stability_particle.png plots/stability_robot.png \
+                 plots/work_precision_particle.png plots/work_precision_robot.png
 
-figures: $(FIGURES) $(STUDY_FIGURES)
+figures: $(FIGURES) $(STUDY_FIGURES) results/step_costs.json
 
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
@@ -87,6 +88,22 @@ results/stability.json: $(BUILD)/bin/study_stability $(SCENES)
 
 plots/stability_%.png: plots/stability.gp plots/style.gp results/stability.json
 	gnuplot -e "file='results/stability.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
+
+.PHONY: study-work-precision
+study-work-precision: plots/work_precision_particle.png plots/work_precision_robot.png results/step_costs.json
+
+# Timed studies run after the others (order-only prerequisites), so that no
+# other job shares the two cores while they measure CPU time.
+results/work_precision.json: $(BUILD)/bin/study_work_precision $(SCENES) \
+    | results/convergence.json results/long_horizon.json results/stability.json $(RUNS)
+	$< --threads $(JOBS) -o $@
+
+plots/work_precision_%.png: plots/work_precision.gp plots/style.gp results/work_precision.json
+	gnuplot -e "file='results/work_precision.json'; scene='$*'; out='$@'" $<
+
+# Micro-benchmarks: ns per step, and the DLA step over the analytic floor.
+results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
+	$< --benchmark_min_time=0.5 -o $@
 
 clean:
 	rm -rf $(BUILD)
