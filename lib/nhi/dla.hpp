@@ -33,11 +33,11 @@ enum class SolveStatus { kConverged, kFailed };
 
 struct StepSummary {
   SolveStatus status = SolveStatus::kFailed;
-  int iterations = 0;           // Newton iterations (plus TinySolver's, if it ran)
-  int evaluations = 0;          // residual(+Jacobian) evaluations
-  double relative_residual = 0; // final max_i |r_i| / size of the terms of r_i
+  int iterations = 0;            // Newton iterations (plus TinySolver's, if it ran)
+  int evaluations = 0;           // residual(+Jacobian) evaluations
+  double relative_residual = 0;  // final max_i |r_i| / size of the terms of r_i
   bool used_fallback = false;
-  std::string message;          // why it failed, when it did
+  std::string message;  // why it failed, when it did
 };
 
 struct DlaOptions {
@@ -160,17 +160,76 @@ class DlaStepper {
   // The residual alone (no derivatives), judged with the scale of a nearby
   // Jacobian Jq (the one the chord iterations use): cheap.
   double evaluate_value(const VecN& q_curr, const VecN& p_curr, const Mat<double, m, n>& W,
-                        const VecN& q1, const VecM& lambda, const Mat<double, N, n>& Jq, VecX* r) const {
+                        const VecN& q1, const VecM& lambda, const Mat<double, N, n>& Jq,
+                        VecX* r) const {
     VecX terms;
     residual<double>(q_curr, p_curr, W, q1, lambda, r, &terms);
     double rel = 0;
     for (int i = 0; i < N; ++i) {
       double scale = terms[i];
-      for (int j = 0; j < n; ++j) scale += std::abs(Jq(i, j)) * (std::abs(q_curr[j]) + std::abs(q1[j]));
+      for (int j = 0; j < n; ++j)
+        scale += std::abs(Jq(i, j)) * (std::abs(q_curr[j]) + std::abs(q1[j]));
       rel = std::max(rel, ratio((*r)[i], scale));
     }
     return rel;
   }
+
+  // Solves the linear system with the matrix (7), [A  -W^T; B  0], A = D2 D1 L_d,
+  // B = D2 omega_d, W = omega(q_k).  While A is comfortably invertible (the usual
+  // case: A ~ -M/h) by the Schur complement on the fixed-size A (Eigen's closed
+  // forms for n <= 4), else by pivoted LU of the whole matrix.
+  class StepSolver {
+   public:
+    explicit StepSolver(const Mat<double, m, n>& W) : Wt_(W.transpose()) {}
+    void factor(const Mat<double, N, n>& Jq) {
+      const Mat<double, n, n> A = Jq.template topRows<n>();
+      B_ = Jq.template bottomRows<m>();
+      bool invertible = false;
+      if constexpr (n <= 4 && m > 0) {
+        // |det A| against the size of its entries, as det scales: relative 1e-10.
+        A.computeInverseWithCheck(Ainv_, invertible, 1e-10 * std::pow(A.cwiseAbs().maxCoeff(), n));
+      }
+      if constexpr (m > 0) {
+        if (invertible) {
+          const Mat<double, m, m> Sm = B_ * Ainv_ * Wt_;  // Schur complement B A^-1 W^T
+          schur_.compute(Sm);
+          schur_ok_ =
+              std::isfinite(Sm.sum()) &&
+              std::abs(schur_.determinant()) > 1e-10 * std::pow(Sm.cwiseAbs().maxCoeff(), m);
+        } else {
+          schur_ok_ = false;
+        }
+      }
+      if (!schur_ok_) {
+        Mat<double, N, N> K = Mat<double, N, N>::Zero();
+        K.template leftCols<n>() = Jq;
+        K.template topRightCorner<n, m>() = -Wt_;
+        lu_.compute(K);
+      }
+    }
+    VecX solve(const VecX& r) const {
+      if constexpr (m == 0) {
+        return lu_.solve(r);
+      } else {
+        if (!schur_ok_) return lu_.solve(r);
+        // A dq - W^T dl = r1,  B dq = r2  =>  (B A^-1 W^T) dl = r2 - B A^-1 r1.
+        const VecN y = Ainv_ * r.template head<n>();
+        const VecM dl = schur_.solve(VecM(r.template tail<m>() - B_ * y));
+        VecX dx;
+        dx.template head<n>() = y + Ainv_ * (Wt_ * dl);
+        dx.template tail<m>() = dl;
+        return dx;
+      }
+    }
+
+   private:
+    Mat<double, n, m> Wt_;
+    Mat<double, m, n> B_;
+    Mat<double, n, n> Ainv_;
+    Eigen::PartialPivLU<Mat<double, m, m>> schur_;
+    Eigen::PartialPivLU<Mat<double, N, N>> lu_;
+    bool schur_ok_ = false;
+  };
 
   static double ratio(double r, double scale) {
     if (!std::isfinite(r) || !std::isfinite(scale)) return std::numeric_limits<double>::infinity();
@@ -185,12 +244,10 @@ class DlaStepper {
     StepSummary s;
     VecN q1 = q_guess;
     VecM lambda = lambda_guess;
-    Mat<double, N, N> K = Mat<double, N, N>::Zero();
-    K.template topRightCorner<n, m>() = -W.transpose();
     double prev = std::numeric_limits<double>::infinity();
     VecX r;
     Mat<double, N, n> Jq;
-    Eigen::PartialPivLU<Mat<double, N, N>> lu;
+    StepSolver solver(W);
     // Newton with the Jacobian (7) refreshed only when the last step contracted
     // the residual by less than 1e-3 (otherwise the factorization is reused):
     // near round-off the converged iterate is the same, with fewer Jet passes.
@@ -207,15 +264,12 @@ class DlaStepper {
       if (rel <= options_.tolerance && (rel <= kRoundoff || rel > 0.5 * prev)) break;
       if (it == options_.max_iterations) {
         if (rel <= options_.tolerance) break;
-        s.message = "no convergence in " + std::to_string(it) +
-                    " iterations (relative residual " + std::to_string(rel) + ")";
+        s.message = "no convergence in " + std::to_string(it) + " iterations (relative residual " +
+                    std::to_string(rel) + ")";
         return s;
       }
-      if (fresh) {
-        K.template leftCols<n>() = Jq;
-        lu.compute(K);
-      }
-      const VecX dx = lu.solve(r);
+      if (fresh) solver.factor(Jq);
+      const VecX dx = solver.solve(r);
       if (!dx.allFinite()) {
         s.message = "singular step matrix (eq. 7)";
         return s;
@@ -287,8 +341,8 @@ class DlaStepper {
       *lambda_out = lambda;
       s.status = SolveStatus::kConverged;
     } else {
-      s.message = "relative residual " + std::to_string(s.relative_residual) +
-                  " after " + std::to_string(summary.iterations) + " iterations";
+      s.message = "relative residual " + std::to_string(s.relative_residual) + " after " +
+                  std::to_string(summary.iterations) + " iterations";
     }
     return s;
   }
