@@ -43,7 +43,7 @@ STUDY_FIGURES := plots/convergence_particle.png plots/convergence_robot.png \
                  plots/stability_particle.png plots/stability_robot.png \
                  plots/work_precision_particle.png plots/work_precision_robot.png
 
-figures: $(FIGURES) $(STUDY_FIGURES) results/step_costs.json
+figures: $(FIGURES) $(STUDY_FIGURES) results/step_costs.json results/summary.md
 
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
@@ -104,6 +104,11 @@ plots/work_precision_%.png: plots/work_precision.gp plots/style.gp results/work_
 # Micro-benchmarks: ns per step, and the DLA step over the analytic floor.
 results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 	$< --benchmark_min_time=0.5 -o $@
+
+# Markdown tables of the study results, quoted in README.md.
+results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json \
+    results/stability.json results/step_costs.json
+	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
 
 clean:
 	rm -rf $(BUILD)
