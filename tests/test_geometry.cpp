@@ -1,0 +1,208 @@
+// The geometry of the discrete flow (paper section 5), checked on real runs.
+//  - Theorem 5.3 (eq. 24), the discrete nonholonomic momentum equation, for the
+//    particle with a potential in y only and for the robot with the planar
+//    Euclidean group; its continuous counterpart (eq. 23) along the benchmark.
+//  - Section 5.1: with no constraints the one-step map (q, p) -> (q', p') is
+//    symplectic; with constraints it is not.
+#include "scenes.hpp"
+
+namespace nhi::test {
+namespace {
+
+template <class S, class D>
+void dla_run(const S& sys, const D& disc, double h, const Vec<double, S::n>& q0,
+             const Vec<double, S::n>& v0, long steps, std::vector<Vec<double, S::n>>* qs,
+             std::vector<Vec<double, S::n>>* ps) {
+  const DlaStepper<S, D> st(sys, disc, h);
+  const RunReport rep = integrate_dla(st, q0, v0, steps, [&](const Sample<S::n, S::m>& s) {
+    qs->push_back(s.q);
+    ps->push_back(s.p);
+    return true;
+  });
+  ASSERT_TRUE(rep.ok) << rep.reason;
+}
+
+// Particle, V = ky y^2 (kx = 0): translations in (x, z) leave L_d and omega_d
+// invariant and the section xi(q) = (1, y) has generator d/dx + y d/dz in D.
+// J_k = <D2 L_d(q_{k-1}, q_k), xi(q_k)_Q> = p_x + y_k p_z, and eq. (24) reads
+//   J_{k+1} - J_k = p_{z,k+1} (y_{k+1} - y_k).
+double particle_momentum_residual(double kx, double alpha) {
+  Particle sys;
+  sys.kx = kx;
+  const Vec<double, 3> q0(1.0, 0.5, 0.0), v0(0.5, 1.0, 0.25);
+  std::vector<Vec<double, 3>> qs, ps;
+  dla_run(sys, AlphaDiscretization{alpha}, 0.2, q0, v0, 2000, &qs, &ps);
+  double worst = 0;
+  for (size_t k = 1; k + 1 < qs.size(); ++k) {
+    const double Jk = ps[k][0] + qs[k][1] * ps[k][2], Jk1 = ps[k + 1][0] + qs[k + 1][1] * ps[k + 1][2];
+    const double rhs = ps[k + 1][2] * (qs[k + 1][1] - qs[k][1]);
+    // The step equations are solved to round-off relative to their terms, which
+    // include (q_{k+1} - q_k)/h: so is eq. (24), a combination of them.
+    const double scale = std::abs(Jk) + std::abs(Jk1) + std::abs(rhs) + ps[k + 1].cwiseAbs().sum() +
+                         (qs[k].cwiseAbs().maxCoeff() + qs[k + 1].cwiseAbs().maxCoeff()) / 0.2;
+    worst = std::max(worst, std::abs(Jk1 - Jk - rhs) / scale);
+  }
+  return worst;
+}
+
+TEST(Theorem53, ParticleDiscreteMomentumEquationHolds) {
+  for (double alpha : {0.5, 0.25}) {
+    const double r = particle_momentum_residual(0.0, alpha);
+    std::printf("    particle, V = y^2, alpha = %g: max relative residual of eq. (24) %.2e\n", alpha, r);
+    EXPECT_LT(r, 1e-13) << "alpha " << alpha;
+  }
+  // With the paper's potential x^2 + y^2, x-translation is no symmetry: eq. (24)
+  // must fail (the check can tell).
+  EXPECT_GT(particle_momentum_residual(1.0, 0.5), 1e-4);
+}
+
+TEST(Theorem53, ParticleContinuousMomentumEquationAlongTheBenchmark) {
+  // Eq. (23): d/dt (xd + y zd) = zd yd, by central differences of the benchmark.
+  Particle sys;
+  sys.kx = 0.0;
+  const Vec<double, 3> q0(1.0, 0.5, 0.0), v0(0.5, 1.0, 0.25);
+  const double dt = 1e-3;
+  std::vector<double> J, rhs;
+  BenchmarkOptions bo;
+  bo.rtol = bo.atol = 1e-13;
+  integrate_benchmark(sys, dt, q0, v0, 20000, bo, [&](const Sample<3, 1>& s) {
+    J.push_back(s.v[0] + s.q[1] * s.v[2]);
+    rhs.push_back(s.v[2] * s.v[1]);
+    return true;
+  });
+  double worst = 0;
+  for (size_t k = 1; k + 1 < J.size(); ++k)
+    worst = std::max(worst, std::abs((J[k + 1] - J[k - 1]) / (2 * dt) - rhs[k]));
+  std::printf("    particle benchmark: max |dJ/dt - zd yd| = %.2e (central differences, dt = 1e-3)\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+// Robot, SE(2) acting on (x, y, theta): the section with generator d/dtheta is
+// xi(q) = (1, (y, -x)) (rotation about the point (x, y)); xi(q_{k+1}) - xi(q_k)
+// is the translation (dy, -dx), so eq. (24) reads
+//   p_{theta,k+1} - p_{theta,k} = p_{x,k+1} (y_{k+1} - y_k) - p_{y,k+1} (x_{k+1} - x_k).
+TEST(Theorem53, RobotDiscreteMomentumEquationHolds) {
+  const Robot sys;
+  const Vec<double, 4> q0(0.0, 0.0, 0.0, 0.0), v0(1.0, 0.0, 1.0, 1.0);
+  for (double alpha : {0.5, 0.25}) {
+    std::vector<Vec<double, 4>> qs, ps;
+    dla_run(sys, AlphaDiscretization{alpha}, 0.2, q0, v0, 2000, &qs, &ps);
+    double worst = 0, largest_rhs = 0;
+    for (size_t k = 1; k + 1 < qs.size(); ++k) {
+      const Vec<double, 4> d = qs[k + 1] - qs[k];
+      const double rhs = ps[k + 1][0] * d[1] - ps[k + 1][1] * d[0];
+      const double scale = std::abs(ps[k][2]) + std::abs(ps[k + 1][0] * d[1]) + std::abs(ps[k + 1][1] * d[0]);
+      worst = std::max(worst, std::abs(ps[k + 1][2] - ps[k][2] - rhs) / scale);
+      largest_rhs = std::max(largest_rhs, std::abs(rhs));
+    }
+    std::printf("    robot, alpha = %g: max relative residual of eq. (24) %.2e (largest right-hand side %.2e)\n",
+                alpha, worst, largest_rhs);
+    EXPECT_LT(worst, 1e-12) << "alpha " << alpha;
+  }
+}
+
+// The robot's Lagrangian with its constraints removed (n = 4, m = 0): a nonlinear
+// unconstrained system for the symplecticity check.
+struct FreeRobot {
+  static constexpr int n = 4, m = 0;
+  static constexpr const char* name = "free robot";
+  Robot r;
+  template <class T>
+  T lagrangian(const Vec<T, 4>& q, const Vec<T, 4>& v) const { return r.lagrangian<T>(q, v); }
+  template <class T>
+  Mat<T, 0, 4> omega(const Vec<T, 4>&) const { return Mat<T, 0, 4>(); }
+  Vec<double, 4> acceleration(const Vec<double, 4>& q, const Vec<double, 4>&) const {
+    return Vec<double, 4>(0, 0, 0, -r.V0 * std::cos(q[3]) / (3 * r.Iw));
+  }
+};
+
+// Jacobian of the one-step map (q, p) -> (q', p') of the DLA (eq. 6 in
+// position-momentum form) at a converged step, by the implicit function theorem
+// on F(q, p, q', lambda) = (p + D1 L_d(q, q') - omega(q)^T lambda, omega_d(q, q')) = 0
+// and p' = D2 L_d(q, q'), all derivatives from one Jet over (q, p, q', lambda).
+template <class S, class D>
+Eigen::MatrixXd step_map_jacobian(const S& sys, const D& disc, double h, const Vec<double, S::n>& q,
+                                  const Vec<double, S::n>& p, const Vec<double, S::n>& q1,
+                                  const Vec<double, S::m>& lambda) {
+  constexpr int n = S::n, m = S::m, K = 3 * n + m;
+  using J = ceres::Jet<double, K>;
+  Vec<J, n> qj, pj, q1j;
+  Vec<J, m> lj;
+  for (int i = 0; i < n; ++i) {
+    qj[i] = J(q[i], i);
+    pj[i] = J(p[i], n + i);
+    q1j[i] = J(q1[i], 2 * n + i);
+  }
+  for (int a = 0; a < m; ++a) lj[a] = J(lambda[a], 3 * n + a);
+  Vec<J, n> D1, D2;
+  discrete_lagrangian_slots<S, D, J>(sys, disc, h, qj, q1j, &D1, &D2);
+  const Vec<J, m> wd = discrete_constraint<S, D, J>(sys, disc, h, qj, q1j);
+  const Mat<J, m, n> W = sys.template omega<J>(qj);
+  Eigen::MatrixXd Fx(n + m, 2 * n), Fy(n + m, n + m), Px(n, 2 * n), Py(n, n + m);
+  Px.setZero();
+  Py.setZero();
+  for (int i = 0; i < n; ++i) {
+    J Fi = pj[i] + D1[i];
+    for (int a = 0; a < m; ++a) Fi = Fi - W(a, i) * lj[a];
+    for (int c = 0; c < 2 * n; ++c) Fx(i, c) = Fi.v[c];
+    for (int c = 0; c < n + m; ++c) Fy(i, c) = Fi.v[2 * n + c];
+    for (int c = 0; c < 2 * n; ++c) Px(i, c) = D2[i].v[c];
+    for (int c = 0; c < n; ++c) Py(i, c) = D2[i].v[2 * n + c];
+  }
+  for (int a = 0; a < m; ++a) {
+    for (int c = 0; c < 2 * n; ++c) Fx(n + a, c) = wd[a].v[c];
+    for (int c = 0; c < n + m; ++c) Fy(n + a, c) = wd[a].v[2 * n + c];
+  }
+  const Eigen::MatrixXd dy = -Fy.fullPivLu().solve(Fx);  // d(q', lambda)/d(q, p)
+  Eigen::MatrixXd Dphi(2 * n, 2 * n);
+  Dphi.topRows(n) = dy.topRows(n);
+  Dphi.bottomRows(n) = Px + Py * dy;
+  return Dphi;
+}
+
+template <class S, class D>
+double symplectic_defect(const S& sys, const D& disc, double h, Vec<double, S::n> q, Vec<double, S::n> v) {
+  constexpr int n = S::n, m = S::m;
+  const DlaStepper<S, D> st(sys, disc, h);
+  Vec<double, n> p = momentum(sys, q, v), q1, p1, guess = q + h * v;
+  Vec<double, m> lambda = Vec<double, m>::Zero();
+  Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  Jm.topRightCorner(n, n) = Eigen::MatrixXd::Identity(n, n);
+  Jm.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
+  double worst = 0;
+  for (int k = 0; k < 50; ++k) {
+    EXPECT_EQ(st.step(q, p, guess, &q1, &lambda, &p1).status, SolveStatus::kConverged);
+    const Eigen::MatrixXd Dphi = step_map_jacobian(sys, disc, h, q, p, q1, lambda);
+    worst = std::max(worst, (Dphi.transpose() * Jm * Dphi - Jm).cwiseAbs().maxCoeff() /
+                                (1.0 + Dphi.cwiseAbs().maxCoeff() * Dphi.cwiseAbs().maxCoeff()));
+    guess = q1 + (q1 - q);
+    q = q1;
+    p = p1;
+  }
+  return worst;
+}
+
+TEST(Symplecticity, UnconstrainedDlaMapIsSymplectic) {
+  const FreeRobot sys;
+  for (double alpha : {0.5, 0.0, 0.3}) {
+    const double d = symplectic_defect(sys, AlphaDiscretization{alpha}, 0.2, Vec<double, 4>(0.1, 0.2, 0.3, 0.4),
+                                       Vec<double, 4>(1.0, -0.5, 0.7, 1.3));
+    std::printf("    no constraints, alpha = %g: max |Dphi^T J Dphi - J| (relative) = %.2e\n", alpha, d);
+    EXPECT_LT(d, 1e-13);
+  }
+  const double s = symplectic_defect(sys, SymmetricDiscretization{0.25}, 0.2, Vec<double, 4>(0.1, 0.2, 0.3, 0.4),
+                                     Vec<double, 4>(1.0, -0.5, 0.7, 1.3));
+  EXPECT_LT(s, 1e-13);
+}
+
+TEST(Symplecticity, ConstrainedDlaMapIsNot) {
+  // Eq. (22): with constraints the discrete form evolves by d(beta_d) != 0.
+  const Robot sys;
+  const double d = symplectic_defect(sys, AlphaDiscretization{0.5}, 0.2, Vec<double, 4>(0, 0, 0, 0),
+                                     Vec<double, 4>(1, 0, 1, 1));
+  std::printf("    robot with constraints: symplectic defect %.2e\n", d);
+  EXPECT_GT(d, 1e-3);
+}
+
+}  // namespace
+}  // namespace nhi::test
