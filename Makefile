@@ -62,44 +62,29 @@ plots/fig4_robot_constraint.png: plots/constraint.gp plots/style.gp $(filter res
 
 # ---- Studies (issue 4): one executable, one JSON, one script each -------------
 SCENES := experiments/scenes/particle.json experiments/scenes/robot.json
-.PHONY: study-convergence
-study-convergence: plots/convergence_particle.png plots/convergence_robot.png
 
-results/convergence.json: $(BUILD)/bin/study_convergence $(SCENES)
+# $(call STUDY,name,target): results/name.json from build/bin/study_name, and
+# plots/name_{particle,robot}.png from plots/name.gp.
+define STUDY
+.PHONY: $(2)
+$(2): plots/$(1)_particle.png plots/$(1)_robot.png
+plots/$(1)_%.png: plots/$(1).gp plots/style.gp results/$(1).json
+	gnuplot -e "file='results/$(1).json'; scene='$$*'; out='$$@'" $$< 2>&1 | { grep -v Skipping || true; }
+endef
+$(eval $(call STUDY,convergence,study-convergence))
+$(eval $(call STUDY,long_horizon,study-long-horizon))
+$(eval $(call STUDY,stability,study-stability))
+$(eval $(call STUDY,work_precision,study-work-precision))
+
+results/convergence.json results/long_horizon.json results/stability.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
 	$< --threads $(JOBS) -o $@
-
-plots/convergence_%.png: plots/convergence.gp plots/style.gp results/convergence.json
-	gnuplot -e "file='results/convergence.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
-
-.PHONY: study-long-horizon
-study-long-horizon: plots/long_horizon_particle.png plots/long_horizon_robot.png
-
-results/long_horizon.json: $(BUILD)/bin/study_long_horizon $(SCENES)
-	$< --threads $(JOBS) -o $@
-
-plots/long_horizon_%.png: plots/long_horizon.gp plots/style.gp results/long_horizon.json
-	gnuplot -e "file='results/long_horizon.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
-
-.PHONY: study-stability
-study-stability: plots/stability_particle.png plots/stability_robot.png
-
-results/stability.json: $(BUILD)/bin/study_stability $(SCENES)
-	$< --threads $(JOBS) -o $@
-
-plots/stability_%.png: plots/stability.gp plots/style.gp results/stability.json
-	gnuplot -e "file='results/stability.json'; scene='$*'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
-
-.PHONY: study-work-precision
-study-work-precision: plots/work_precision_particle.png plots/work_precision_robot.png results/step_costs.json
 
 # Timed studies run after the others (order-only prerequisites), so that no
 # other job shares the two cores while they measure CPU time.
 results/work_precision.json: $(BUILD)/bin/study_work_precision $(SCENES) \
     | results/convergence.json results/long_horizon.json results/stability.json $(RUNS)
 	$< --threads $(JOBS) -o $@
-
-plots/work_precision_%.png: plots/work_precision.gp plots/style.gp results/work_precision.json
-	gnuplot -e "file='results/work_precision.json'; scene='$*'; out='$@'" $<
+study-work-precision: results/step_costs.json
 
 # Micro-benchmarks: ns per step, and the DLA step over the analytic floor.
 results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json

@@ -132,4 +132,18 @@ json to_json(const nhi::Vec<double, N>& v) {
 
 using nhi::loglog_slope;
 
+// q(T) by the CVODE benchmark at rtol = atol = tol: the reference solution.
+template <class S>
+nhi::Vec<double, S::n> reference_q(const S& sys, const nhi::Vec<double, S::n>& q0,
+                                   const nhi::Vec<double, S::n>& v0, double T, double tol) {
+  nhi::Vec<double, S::n> q = q0;
+  nhi::BenchmarkOptions opt;
+  opt.rtol = opt.atol = tol;
+  nhi::integrate_benchmark(sys, T, q0, v0, 1, opt, [&](const nhi::Sample<S::n, S::m>& s) {
+    q = s.q;
+    return true;
+  });
+  return q;
+}
+
 }  // namespace study

@@ -29,18 +29,6 @@ struct Variant {
   std::function<json(double h)> error_at;  // returns {"error", "cpu_seconds", "status"}
 };
 
-template <class S>
-Vec<double, S::n> reference(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0) {
-  Vec<double, S::n> q = q0;
-  nhi::BenchmarkOptions opt;
-  opt.rtol = opt.atol = 1e-13;
-  nhi::integrate_benchmark(sys, kT, q0, v0, 1, opt, [&](const nhi::Sample<S::n, S::m>& s) {
-    q = s.q;
-    return true;
-  });
-  return q;
-}
-
 // Error of one run that ends at q(T).
 template <class S, class Run>
 json measure(const Vec<double, S::n>& qref, Run&& run) {
@@ -137,7 +125,7 @@ int main(int argc, char** argv) {
     const json sc = study::scene(opt, name);
     json scene_out = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
-      const Vec<double, S::n> qref = reference(sys, q0, v0);
+      const Vec<double, S::n> qref = study::reference_q(sys, q0, v0, kT, 1e-13);
       const auto vs = variants(sys, q0, v0, qref);
       std::vector<json> runs(vs.size() * hs.size());
       study::Progress progress("convergence " + name, static_cast<long>(runs.size()));

@@ -77,13 +77,7 @@ int main(int argc, char** argv) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
-      Vec<double, S::n> qref = q0;
-      nhi::BenchmarkOptions bo;
-      bo.rtol = bo.atol = 1e-12;
-      nhi::integrate_benchmark(sys, kT, q0, v0, 1, bo, [&](const nhi::Sample<S::n, S::m>& s) {
-        qref = s.q;
-        return true;
-      });
+      const Vec<double, S::n> qref = study::reference_q(sys, q0, v0, kT, 1e-12);
       std::vector<json> runs(methods.size() * hs.size());
       study::Progress progress("stability " + name, static_cast<long>(runs.size()));
       study::parallel_for(runs.size(), opt.threads, [&](size_t i) {

@@ -130,13 +130,7 @@ int main(int argc, char** argv) {
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
       constexpr int n = S::n;
-      Vec<double, n> qref = q0;
-      nhi::BenchmarkOptions bo;
-      bo.rtol = bo.atol = 1e-13;
-      nhi::integrate_benchmark(sys, kT_final, q0, v0, 1, bo, [&](const nhi::Sample<n, S::m>& s) {
-        qref = s.q;
-        return true;
-      });
+      const Vec<double, n> qref = study::reference_q(sys, q0, v0, kT_final, 1e-13);
       const double E0 = nhi::energy(sys, q0, v0);
       std::vector<json> rows(configs.size());
       study::Progress progress("work-precision " + name, static_cast<long>(configs.size()));
