@@ -27,6 +27,10 @@ build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
 	cmake --build $(BUILD) -j$(JOBS)
 
+# A figure or study target asked for directly builds the binaries if they are missing.
+$(BUILD)/bin/%:
+	$(MAKE) build
+
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
 
