@@ -26,6 +26,9 @@ int error(const std::string& message, int code = 2) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Handlers first: from here on an interrupt is a clean "nothing written".
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
   CLI::App app{"Nonholonomic integrators (Cortes & Martinez 2001): run one scene"};
   app.require_subcommand(1);
   auto* run = app.add_subcommand("run", "Run SCENE.json and write the result as JSON");
@@ -67,8 +70,6 @@ int main(int argc, char** argv) {
     if (out) out->discard();
   };
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
   nhi::json result;
   try {
     result = nhi::run_scene(resolved);

@@ -166,7 +166,20 @@ TEST_F(Cli, InterruptedRunWritesNothing) {
             "output_every=100000000", "-o", out.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  ::usleep(300000);  // the run is under way (it would take minutes)
+  // Wait until the run has claimed its temporary output (the handlers are
+  // installed before that), then interrupt it: the run itself would take minutes.
+  auto claimed = [&] {
+    for (const auto& e : fs::directory_iterator(dir_))
+      if (e.path().filename().string().find("i.json.tmp.") == 0) return true;
+    return false;
+  };
+  for (int i = 0; i < 2000 && !claimed(); ++i) ::usleep(5000);
+  if (!claimed()) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, nullptr, 0);
+    FAIL() << "the run never started";
+  }
+  ::usleep(100000);
   ::kill(pid, SIGTERM);
   int status = 0;
   ::waitpid(pid, &status, 0);
