@@ -10,7 +10,7 @@ BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2
 
-.PHONY: all deps build test reproduce figures clean
+.PHONY: all deps build test test-sanitize reproduce figures clean
 all: build
 
 deps:
@@ -33,6 +33,15 @@ $(BUILD)/bin/%:
 
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
+
+# The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer (its own
+# build tree; slow: about 25 minutes to build on 2 cores).
+SANITIZE := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+test-sanitize: deps
+	cmake -S . -B $(BUILD)-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNHI_NATIVE=OFF \
+	  -DCMAKE_CXX_FLAGS="$(SANITIZE)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE)"
+	cmake --build $(BUILD)-sanitize -j$(JOBS)
+	UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir $(BUILD)-sanitize --output-on-failure -j$(JOBS)
 
 reproduce: build
 	$(MAKE) -j$(JOBS) figures
