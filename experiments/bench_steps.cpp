@@ -21,14 +21,15 @@ using nhi::Vec;
 constexpr double kH = 0.2;
 constexpr int kStates = 256;
 
+// The initial state of the scene file experiments/scenes/<system>.json (run from
+// the repository root, as `make reproduce` does).
 template <class S>
 void scene_state(Vec<double, S::n>* q, Vec<double, S::n>* v) {
-  if constexpr (std::is_same_v<S, nhi::Particle>) {
-    *q << 1.0, 0.5, 0.0;
-    *v << 0.5, 1.0, 0.25;
-  } else {
-    *q << 0.0, 0.0, 0.0, 0.0;
-    *v << 1.0, 0.0, 1.0, 1.0;
+  static const nhi::json scene =
+      nhi::validate_scene(nhi::load_scene_file(std::string("experiments/scenes/") + S::name + ".json"));
+  for (int i = 0; i < S::n; ++i) {
+    (*q)[i] = scene["q0"][i].get<double>();
+    (*v)[i] = scene["v0"][i].get<double>();
   }
 }
 

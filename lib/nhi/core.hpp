@@ -45,9 +45,4 @@ inline double value_of(const T& x) {
   }
 }
 
-template <int N>
-inline bool all_finite(const Vec<double, N>& x) {
-  return x.allFinite();
-}
-
 }  // namespace nhi

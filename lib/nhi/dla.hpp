@@ -187,7 +187,7 @@ class DlaStepper {
       bool invertible = false;
       if constexpr (n <= 4 && m > 0) {
         // |det A| against the size of its entries, as det scales: relative 1e-10.
-        A.computeInverseWithCheck(Ainv_, invertible, 1e-10 * std::pow(A.cwiseAbs().maxCoeff(), n));
+        A.computeInverseWithCheck(Ainv_, invertible, 1e-10 * std::pow(max_abs(A), n));
       }
       if constexpr (m > 0) {
         if (invertible) {
@@ -195,7 +195,7 @@ class DlaStepper {
           schur_.compute(Sm);
           schur_ok_ =
               std::isfinite(Sm.sum()) &&
-              std::abs(schur_.determinant()) > 1e-10 * std::pow(Sm.cwiseAbs().maxCoeff(), m);
+              std::abs(schur_.determinant()) > 1e-10 * std::pow(max_abs(Sm), m);
         } else {
           schur_ok_ = false;
         }
@@ -223,6 +223,16 @@ class DlaStepper {
     }
 
    private:
+    // Largest |entry| by a plain loop: Eigen's vectorized maxCoeff on a 4x4 trips a
+    // false -Wuninitialized in GCC 12's AVX-512 intrinsics under -march=native.
+    template <class M>
+    static double max_abs(const M& a) {
+      double x = 0;
+      for (int i = 0; i < a.rows(); ++i)
+        for (int j = 0; j < a.cols(); ++j) x = std::max(x, std::abs(a(i, j)));
+      return x;
+    }
+
     Mat<double, n, m> Wt_;
     Mat<double, m, n> B_;
     Mat<double, n, n> Ainv_;

@@ -60,11 +60,6 @@ class Recorder {
                     {"max_abs_constraint", max_c_}};
   }
 
-  double max_abs_energy_error() const { return max_dE_; }
-  double max_abs_constraint() const { return max_c_; }
-  const std::vector<double>& t() const { return t_; }
-  const std::vector<double>& energies() const { return E_; }
-
  private:
   void flush() {
     if (!have_pending_) return;
