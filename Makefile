@@ -56,7 +56,9 @@ STUDY_FIGURES := plots/convergence_particle.png plots/convergence_robot.png \
                  plots/stability_particle.png plots/stability_robot.png \
                  plots/work_precision_particle.png plots/work_precision_robot.png
 
-figures: $(FIGURES) $(STUDY_FIGURES) results/step_costs.json results/summary.md
+GEOMETRY_FIGURES := plots/geometry_momentum.png plots/geometry_extrinsic.png
+
+figures: $(FIGURES) $(STUDY_FIGURES) $(GEOMETRY_FIGURES) results/step_costs.json results/summary.md
 
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
@@ -89,13 +91,19 @@ $(eval $(call STUDY,long_horizon,study-long-horizon))
 $(eval $(call STUDY,stability,study-stability))
 $(eval $(call STUDY,work_precision,study-work-precision))
 
-results/convergence.json results/long_horizon.json results/stability.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
+results/convergence.json results/long_horizon.json results/stability.json results/geometry.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
 	$< --threads $(JOBS) -o $@
+
+# ---- The geometry of the discrete flow (issue 5): eq. 24, eq. 17, Remark 3.3 ---
+.PHONY: study-geometry
+study-geometry: $(GEOMETRY_FIGURES)
+plots/geometry_%.png: plots/geometry_%.gp plots/style.gp results/geometry.json
+	gnuplot -e "file='results/geometry.json'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
 
 # Timed studies run after the others (order-only prerequisites), so that no
 # other job shares the two cores while they measure CPU time.
 results/work_precision.json: $(BUILD)/bin/study_work_precision $(SCENES) \
-    | results/convergence.json results/long_horizon.json results/stability.json $(RUNS)
+    | results/convergence.json results/long_horizon.json results/stability.json results/geometry.json $(RUNS)
 	$< --threads $(JOBS) -o $@
 study-work-precision: results/step_costs.json
 

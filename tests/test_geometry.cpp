@@ -4,6 +4,7 @@
 //    Euclidean group; its continuous counterpart (eq. 23) along the benchmark.
 //  - Section 5.1: with no constraints the one-step map (q, p) -> (q', p') is
 //    symplectic; with constraints it is not.
+#include "nhi/systems/circle.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {
@@ -34,8 +35,9 @@ double particle_momentum_residual(double kx, double alpha) {
   dla_run(sys, AlphaDiscretization{alpha}, 0.2, q0, v0, 2000, &qs, &ps);
   double worst = 0;
   for (size_t k = 1; k + 1 < qs.size(); ++k) {
-    const double Jk = ps[k][0] + qs[k][1] * ps[k][2], Jk1 = ps[k + 1][0] + qs[k + 1][1] * ps[k + 1][2];
-    const double rhs = ps[k + 1][2] * (qs[k + 1][1] - qs[k][1]);
+    const double Jk = Particle::nonholonomic_momentum(qs[k], ps[k]);
+    const double Jk1 = Particle::nonholonomic_momentum(qs[k + 1], ps[k + 1]);
+    const double rhs = Particle::momentum_equation_rhs(qs[k], qs[k + 1], ps[k + 1]);
     // The step equations are solved to round-off relative to their terms, which
     // include (q_{k+1} - q_k)/h: so is eq. (24), a combination of them.
     const double scale = std::abs(Jk) + std::abs(Jk1) + std::abs(rhs) + ps[k + 1].cwiseAbs().sum() +
@@ -90,9 +92,10 @@ TEST(Theorem53, RobotDiscreteMomentumEquationHolds) {
     double worst = 0, largest_rhs = 0;
     for (size_t k = 1; k + 1 < qs.size(); ++k) {
       const Vec<double, 4> d = qs[k + 1] - qs[k];
-      const double rhs = ps[k + 1][0] * d[1] - ps[k + 1][1] * d[0];
+      const double rhs = Robot::momentum_equation_rhs(qs[k], qs[k + 1], ps[k + 1]);
       const double scale = std::abs(ps[k][2]) + std::abs(ps[k + 1][0] * d[1]) + std::abs(ps[k + 1][1] * d[0]);
-      worst = std::max(worst, std::abs(ps[k + 1][2] - ps[k][2] - rhs) / scale);
+      worst = std::max(worst, std::abs(Robot::nonholonomic_momentum(qs[k + 1], ps[k + 1]) -
+                                       Robot::nonholonomic_momentum(qs[k], ps[k]) - rhs) / scale);
       largest_rhs = std::max(largest_rhs, std::abs(rhs));
     }
     std::printf("    robot, alpha = %g: max relative residual of eq. (24) %.2e (largest right-hand side %.2e)\n",
@@ -120,10 +123,16 @@ struct FreeRobot {
 // position-momentum form) at a converged step, by the implicit function theorem
 // on F(q, p, q', lambda) = (p + D1 L_d(q, q') - omega(q)^T lambda, omega_d(q, q')) = 0
 // and p' = D2 L_d(q, q'), all derivatives from one Jet over (q, p, q', lambda).
+//
+// Eq. (22) in these coordinates: with p' dq' = d L_d + p dq - beta, where
+// beta = lambda_a(q, p) omega^a(q) dq (the constraint force one-form, in D°),
+//   phi^*(dq ^ dp) = dq ^ dp + d(beta),  i.e.  Dphi^T J Dphi - J = G^T - G,
+// G the Jacobian of the coefficients b(q, p) = (omega(q)^T lambda(q, p), 0).
+// *dbeta (optional) gets G^T - G.
 template <class S, class D>
 Eigen::MatrixXd step_map_jacobian(const S& sys, const D& disc, double h, const Vec<double, S::n>& q,
                                   const Vec<double, S::n>& p, const Vec<double, S::n>& q1,
-                                  const Vec<double, S::m>& lambda) {
+                                  const Vec<double, S::m>& lambda, Eigen::MatrixXd* dbeta = nullptr) {
   constexpr int n = S::n, m = S::m, K = 3 * n + m;
   using J = ceres::Jet<double, K>;
   Vec<J, n> qj, pj, q1j;
@@ -157,6 +166,14 @@ Eigen::MatrixXd step_map_jacobian(const S& sys, const D& disc, double h, const V
   Eigen::MatrixXd Dphi(2 * n, 2 * n);
   Dphi.topRows(n) = dy.topRows(n);
   Dphi.bottomRows(n) = Px + Py * dy;
+  if (dbeta) {
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(2 * n, 2 * n);  // G(i, c) = d b_i / d x_c
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < 2 * n; ++c)
+        for (int a = 0; a < m; ++a)
+          G(i, c) += (c < n ? W(a, i).v[c] * lambda[a] : 0.0) + W(a, i).a * dy(n + a, c);
+    *dbeta = G.transpose() - G;
+  }
   return Dphi;
 }
 
@@ -210,6 +227,113 @@ TEST(Symplecticity, ConstrainedDlaMapIsNot) {
                                      Vec<double, 4>(1, 0, 1, 1));
   std::printf("    robot with constraints: symplectic defect %.2e\n", d);
   EXPECT_GT(d, 1e-3);
+}
+
+// Eq. (22) itself: the defect Dphi^T J Dphi - J is exactly d(beta_d), the
+// exterior derivative of the constraint-force one-form of the step, to round-off.
+template <class S, class D>
+void check_eq22(const S& sys, const D& disc, double h, Vec<double, S::n> q, Vec<double, S::n> v) {
+  constexpr int n = S::n, m = S::m;
+  const DlaStepper<S, D> st(sys, disc, h);
+  Vec<double, n> p = momentum(sys, q, v), q1, p1, guess = q + h * v;
+  Vec<double, m> lambda = Vec<double, m>::Zero();
+  Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(2 * n, 2 * n), dbeta;
+  Jm.topRightCorner(n, n) = Eigen::MatrixXd::Identity(n, n);
+  Jm.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
+  double worst = 0, smallest = 1e300;
+  for (int k = 0; k < 100; ++k) {
+    ASSERT_EQ(st.step(q, p, guess, &q1, &lambda, &p1).status, SolveStatus::kConverged);
+    const Eigen::MatrixXd Dphi = step_map_jacobian(sys, disc, h, q, p, q1, lambda, &dbeta);
+    const Eigen::MatrixXd defect = Dphi.transpose() * Jm * Dphi - Jm;
+    const double size = max_abs(Dphi);
+    worst = std::max(worst, max_abs(defect - dbeta) / (1.0 + size * size));
+    smallest = std::min(smallest, max_abs(defect));
+    guess = q1 + (q1 - q);
+    q = q1;
+    p = p1;
+  }
+  std::printf("    %s, %s: max |Dphi^T J Dphi - J - d(beta_d)| (relative) = %.2e; the defect itself >= %.2e\n",
+              S::name, disc.name().c_str(), worst, smallest);
+  EXPECT_LT(worst, 1e-13);
+  EXPECT_GT(smallest, 1e-3);  // and the defect is really there
+}
+
+TEST(Symplecticity, DefectIsTheExteriorDerivativeOfTheConstraintForce) {
+  const Particle particle;
+  const Robot robot;
+  for (double alpha : {0.5, 0.25}) {
+    check_eq22(particle, AlphaDiscretization{alpha}, 0.2, Vec<double, 3>(1.0, 0.5, 0.0),
+               Vec<double, 3>(0.5, 1.0, 0.25));
+    check_eq22(robot, AlphaDiscretization{alpha}, 0.2, Vec<double, 4>(0, 0, 0, 0), Vec<double, 4>(1, 0, 1, 1));
+  }
+  check_eq22(robot, SymmetricDiscretization{0.25}, 0.2, Vec<double, 4>(0, 0, 0, 0), Vec<double, 4>(1, 0, 1, 1));
+}
+
+// Removing the constraints' non-integrability: the particle with
+// omega_eps = dz - eps y dx.  The DLA maps T*Q onto the (2n - m)-dimensional
+// set M_d = {(q', D2 L_d(q, q')) : omega_d(q, q') = 0}, and on T*Q the defect
+// never vanishes (the multiplier absorbs p_z).  On M_d it does when eps = 0
+// (dz: z = const, a holonomic constraint, and the DLA is the variational
+// integrator on the leaf, Remark 3.3), and it grows with eps:
+// the form restricted to M_d, pulled back by one step, against itself.
+struct EpsParticle {
+  static constexpr int n = 3, m = 1;
+  static constexpr const char* name = "particle, omega = dz - eps y dx";
+  double eps = 1.0;
+  Particle base;
+  template <class T>
+  T lagrangian(const Vec<T, 3>& q, const Vec<T, 3>& v) const { return base.lagrangian<T>(q, v); }
+  template <class T>
+  Mat<T, 1, 3> omega(const Vec<T, 3>& q) const {
+    Mat<T, 1, 3> w;
+    w << -cst<T>(eps) * q[1], cst<T>(0.0), cst<T>(1.0);
+    return w;
+  }
+};
+
+double restricted_defect(double eps) {
+  EpsParticle sys;
+  sys.eps = eps;
+  constexpr int n = 3;
+  const double h = 0.2;
+  const AlphaDiscretization disc{0.5};
+  const DlaStepper<EpsParticle, AlphaDiscretization> st(sys, disc, h);
+  Vec<double, n> q(1.0, 0.5, 0.0), v(0.5, 1.0, 0.25 * eps), q1, p1, guess = q + h * v;
+  Vec<double, n> p = momentum(sys, q, v);
+  Vec<double, 1> lambda = Vec<double, 1>::Zero();
+  Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  Jm.topRightCorner(n, n) = Eigen::MatrixXd::Identity(n, n);
+  Jm.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
+  Eigen::MatrixXd prev;  // Dphi of the previous step: its range is T M_d at the current point
+  double worst = 0;
+  for (int k = 0; k < 60; ++k) {
+    EXPECT_EQ(st.step(q, p, guess, &q1, &lambda, &p1).status, SolveStatus::kConverged);
+    const Eigen::MatrixXd Dphi = step_map_jacobian(sys, disc, h, q, p, q1, lambda);
+    if (k > 0) {
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(prev, Eigen::ComputeFullU);
+      const Eigen::MatrixXd T = svd.matrixU().leftCols(2 * n - 1);  // range of prev: T M_d
+      const Eigen::MatrixXd d = T.transpose() * (Dphi.transpose() * Jm * Dphi - Jm) * T;
+      const double size = max_abs(Dphi);
+      worst = std::max(worst, max_abs(d) / (1.0 + size * size));
+    }
+    prev = Dphi;
+    guess = q1 + (q1 - q);
+    q = q1;
+    p = p1;
+  }
+  return worst;
+}
+
+TEST(Symplecticity, DefectOnTheDiscreteConstraintSetShrinksAsTheConstraintBecomesIntegrable) {
+  std::vector<double> eps{1.0, 0.1, 0.01, 0.001}, defects;
+  for (double e : eps) defects.push_back(restricted_defect(e));
+  const double zero = restricted_defect(0.0);
+  std::printf("    restricted defect at eps = 1, 0.1, 0.01, 0.001, 0: %.2e %.2e %.2e %.2e %.2e (slope %.2f)\n",
+              defects[0], defects[1], defects[2], defects[3], zero, loglog_slope(eps, defects));
+  EXPECT_LT(zero, 1e-13);
+  for (size_t i = 1; i < eps.size(); ++i) EXPECT_LT(defects[i], defects[i - 1]);
+  EXPECT_NEAR(loglog_slope(eps, defects), 1.0, 0.1);  // O(eps): d(omega_eps) = eps dx ^ dy
+  EXPECT_GT(defects[0], 1e-3);
 }
 
 // Corollary 5.4 needs a constant Lie-algebra element whose generator lies in D
@@ -278,25 +402,6 @@ TEST(Corollary54, HorizontalSymmetryMomentumIsConservedExactly) {
 // and omega(q_k)^T lambda = lambda DG(q_k): the midpoint DLA is the SHAKE-type
 // variational integrator  D1 L_d + D2 L_d = lambda DG(q_k),  G(q_{k+1}) = G(q_0),
 // which we solve here separately, with its own Newton, and compare.
-struct CircleParticle {
-  static constexpr int n = 2, m = 1;
-  static constexpr const char* name = "particle on a circle";
-  double g = 1.0;
-  template <class T>
-  T lagrangian(const Vec<T, 2>& q, const Vec<T, 2>& v) const {
-    return cst<T>(0.5) * (v[0] * v[0] + v[1] * v[1]) - cst<T>(g) * q[1];
-  }
-  template <class T>
-  Mat<T, 1, 2> omega(const Vec<T, 2>& q) const {
-    Mat<T, 1, 2> w;
-    w << q[0], q[1];
-    return w;
-  }
-  Vec<double, 2> acceleration(const Vec<double, 2>& q, const Vec<double, 2>& v) const {
-    return generic_acceleration(*this, q, v);
-  }
-};
-
 TEST(Remark33, MidpointDlaIsShakeOnTheCircle) {
   const CircleParticle sys;
   const double h = 0.1;
@@ -315,7 +420,7 @@ TEST(Remark33, MidpointDlaIsShakeOnTheCircle) {
     for (int it = 0; it < 30; ++it) {
       const Eigen::Vector2d q1 = x.head<2>();
       Eigen::Vector3d r;
-      r.head<2>() = p - (q1 - q) / h - Eigen::Vector2d(0.0, 0.5 * h * sys.g) - x[2] * q;
+      r.head<2>() = p - (q1 - q) / h - Eigen::Vector2d(0.0, 0.5 * h * sys.gravity) - x[2] * q;
       r[2] = 0.5 * (q1.squaredNorm() - q.squaredNorm());  // same level set as q_k (D_d of Remark 3.3)
       Eigen::Matrix3d J;
       J << -1 / h, 0, -q[0], 0, -1 / h, -q[1], q1[0], q1[1], 0;
@@ -324,7 +429,7 @@ TEST(Remark33, MidpointDlaIsShakeOnTheCircle) {
       if (dx.cwiseAbs().maxCoeff() < 1e-16 * (1 + x.cwiseAbs().maxCoeff())) break;
     }
     const Eigen::Vector2d q1 = x.head<2>();
-    const Eigen::Vector2d p1 = (q1 - q) / h - Eigen::Vector2d(0.0, 0.5 * h * sys.g);
+    const Eigen::Vector2d p1 = (q1 - q) / h - Eigen::Vector2d(0.0, 0.5 * h * sys.gravity);
     worst = std::max(worst, std::max((q1 - qs[k + 1]).cwiseAbs().maxCoeff(),
                                      h * (p1 - ps[k + 1]).cwiseAbs().maxCoeff()));
     if (k >= 1) {
@@ -339,6 +444,37 @@ TEST(Remark33, MidpointDlaIsShakeOnTheCircle) {
   EXPECT_LT(worst, 64 * std::numeric_limits<double>::epsilon());
   EXPECT_LT(radius_drift, 1e-11);  // round-off random walk of a conserved |q|
   EXPECT_LT(worst_energy, 0.05);  // bounded, O(h^2)
+}
+
+// The same circle in the Constrained Coordinate Formulation (eq. 17): its force
+// row Dg(q_k) = q_k^T is the omega row and g(q_{k+1}) = 0 is the midpoint
+// omega_d = 0 on the unit circle, so the eq.-17 step must give the omega-DLA step.
+TEST(Remark33, HolonomicFormulationGivesTheSameStep) {
+  const double h = 0.1;
+  const Vec<double, 2> q0(std::cos(-0.3), std::sin(-0.3)), v0 = 1.7 * Vec<double, 2>(-q0[1], q0[0]);
+  std::vector<Vec<double, 2>> qa, pa, qb, pb;
+  dla_run(CircleParticle{}, AlphaDiscretization{0.5}, h, q0, v0, 5000, &qa, &pa);
+  // One eq.-17 step from each state of the omega run.  The omega step keeps
+  // |q_{k+1}| = |q_k|, the g step |q_{k+1}| = 1: they differ by the radius's
+  // round-off drift ||q_k| - 1| (3e-12 here) and by the solver's round-off.
+  const DlaStepper<CircleHolonomic, AlphaDiscretization> st(CircleHolonomic{}, AlphaDiscretization{0.5}, h);
+  double worst = 0, radius = 0;
+  for (size_t k = 0; k + 1 < qa.size(); ++k) {
+    Vec<double, 2> q1, p1;
+    Vec<double, 1> lam = Vec<double, 1>::Zero();
+    ASSERT_EQ(st.step(qa[k], pa[k], qa[k] + h * pa[k], &q1, &lam, &p1).status, SolveStatus::kConverged);
+    radius = std::max(radius, std::abs(qa[k].norm() - 1.0));
+    worst = std::max(worst, std::max((q1 - qa[k + 1]).cwiseAbs().maxCoeff(), h * (p1 - pa[k + 1]).cwiseAbs().maxCoeff()));
+  }
+  // The whole run in the g formulation, for the record (round-off differences
+  // become a phase difference that grows along the run).
+  dla_run(CircleHolonomic{}, AlphaDiscretization{0.5}, h, q0, v0, 5000, &qb, &pb);
+  double run = 0;
+  for (size_t k = 0; k < qa.size(); ++k) run = std::max(run, (qa[k] - qb[k]).cwiseAbs().maxCoeff());
+  std::printf("    circle: one eq.-17 step vs the omega-DLA step: max difference %.2e (radius drift %.2e); whole runs differ by %.2e after 5000 steps\n",
+              worst, radius, run);
+  EXPECT_LT(worst, 4 * radius + 64 * std::numeric_limits<double>::epsilon());
+  EXPECT_LT(run, 1e-7);
 }
 
 }  // namespace

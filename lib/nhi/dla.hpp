@@ -4,6 +4,10 @@
 //     p_k + D1 L_d(q_k, q_{k+1}) - omega(q_k)^T lambda_k = 0       (eq. 6, first line)
 //     omega_d(q_k, q_{k+1})                            = 0       (eq. 6, second line)
 // for (q_{k+1}, lambda_k); then p_{k+1} = D2 L_d(q_k, q_{k+1}).
+// A system with l holonomic constraints g (system.hpp) gets the Constrained
+// Coordinate Formulation (eq. 17) instead: l more multipliers on the rows Dg(q_k)
+// and l more equations g(q_{k+1}) = 0; the multiplier vector is (mu, lambda)
+// with mu on omega first.
 // The Jacobian of the residual is the matrix (7):
 //     [ D2 D1 L_d(q_k, q_{k+1})   -omega(q_k)^T ]
 //     [ D2 omega_d(q_k, q_{k+1})        0       ]
@@ -50,10 +54,12 @@ template <class S, class D>
 class DlaStepper {
  public:
   static constexpr int n = S::n;
-  static constexpr int m = S::m;
-  static constexpr int N = n + m;
+  static constexpr int m = S::m;                       // nonholonomic constraints omega
+  static constexpr int l = holonomic_count<S>::value;  // holonomic constraints g (eq. 17)
+  static constexpr int mc = m + l;                     // multipliers (mu, lambda)
+  static constexpr int N = n + mc;
   using VecN = Vec<double, n>;
-  using VecM = Vec<double, m>;
+  using VecM = Vec<double, mc>;
   using VecX = Vec<double, N>;
 
   DlaStepper(const S& sys, const D& disc, double h, DlaOptions options = {})
@@ -70,7 +76,7 @@ class DlaStepper {
   // starting iterate; on success q_next, lambda and p_next hold the solution.
   StepSummary step(const VecN& q_curr, const VecN& p_curr, const VecN& q_guess, VecN* q_next,
                    VecM* lambda, VecN* p_next) const {
-    const Mat<double, m, n> W = sys_.template omega<double>(q_curr);
+    const Mat<double, mc, n> W = force_forms(q_curr);
     StepSummary s = newton(q_curr, p_curr, W, q_guess, *lambda, q_next, lambda);
     if (s.status != SolveStatus::kConverged && options_.fallback) {
       StepSummary f = tiny_solver(q_curr, p_curr, W, q_guess, *lambda, q_next, lambda);
@@ -94,7 +100,7 @@ class DlaStepper {
   // Relative residual of eq. (6) at (q_next, lambda); *r_out gets the residual.
   double relative_residual(const VecN& q_curr, const VecN& p_curr, const VecN& q_next,
                            const VecM& lambda, VecX* r_out = nullptr) const {
-    const Mat<double, m, n> W = sys_.template omega<double>(q_curr);
+    const Mat<double, mc, n> W = force_forms(q_curr);
     VecX r;
     Mat<double, N, n> Jq;
     const double rel = evaluate(q_curr, p_curr, W, q_next, lambda, &r, &Jq);
@@ -103,11 +109,20 @@ class DlaStepper {
   }
 
  private:
-  // r = (p_k + D1 L_d(q_k, q1) - W^T lambda, omega_d(q_k, q1)), W = omega(q_k);
+  // The one-forms the multipliers act on at q_k: omega(q_k) and, with holonomic
+  // constraints, Dg(q_k) below it (eq. 17, first line).
+  Mat<double, mc, n> force_forms(const VecN& q) const {
+    Mat<double, mc, n> W;
+    W.template topRows<m>() = sys_.template omega<double>(q);
+    if constexpr (l > 0) W.template bottomRows<l>() = holonomic_jacobian(sys_, q);
+    return W;
+  }
+
+  // r = (p_k + D1 L_d(q_k, q1) - W^T lambda, omega_d(q_k, q1) [, g(q1)]), W = force_forms(q_k);
   // *terms gets, per row, the sum of the magnitudes of the terms r_i adds up.
   template <class T>
-  void residual(const VecN& q_curr, const VecN& p_curr, const Mat<double, m, n>& W,
-                const Vec<T, n>& q1, const Vec<T, m>& lambda, Vec<T, N>* r,
+  void residual(const VecN& q_curr, const VecN& p_curr, const Mat<double, mc, n>& W,
+                const Vec<T, n>& q1, const Vec<T, mc>& lambda, Vec<T, N>* r,
                 VecX* terms = nullptr) const {
     const Vec<T, n> q0 = q_curr.template cast<T>();
     Vec<T, n> D1;
@@ -117,7 +132,7 @@ class DlaStepper {
     for (int i = 0; i < n; ++i) {
       T force = cst<T>(0.0);
       double fscale = 0;
-      for (int a = 0; a < m; ++a) {
+      for (int a = 0; a < mc; ++a) {
         force += cst<T>(W(a, i)) * lambda[a];
         fscale += std::abs(W(a, i) * value_of(lambda[a]));
       }
@@ -128,6 +143,13 @@ class DlaStepper {
       (*r)[n + a] = wd[a];
       if (terms) (*terms)[n + a] = cscale[a];
     }
+    if constexpr (l > 0) {  // g(q_{k+1}) = 0 (eq. 17, second line); its scale comes from Dg
+      const Vec<T, l> gv = sys_.template g<T>(q1);
+      for (int a = 0; a < l; ++a) {
+        (*r)[n + m + a] = gv[a];
+        if (terms) (*terms)[n + m + a] = 0;
+      }
+    }
   }
 
   // Residual and its q1-Jacobian Jq by one Jet evaluation; returns the relative
@@ -135,12 +157,12 @@ class DlaStepper {
   // second part is the residual a relative perturbation of q of one unit causes,
   // so the floor it sets is round-off in the difference quotient (q1 - q0)/h,
   // which grows with |q| (a coordinate that has travelled far, like z).
-  double evaluate(const VecN& q_curr, const VecN& p_curr, const Mat<double, m, n>& W,
+  double evaluate(const VecN& q_curr, const VecN& p_curr, const Mat<double, mc, n>& W,
                   const VecN& q1, const VecM& lambda, VecX* r, Mat<double, N, n>* Jq) const {
     using J = ceres::Jet<double, n>;
     Vec<J, n> q1j;
     for (int i = 0; i < n; ++i) q1j[i] = J(q1[i], i);
-    const Vec<J, m> lj = lambda.template cast<J>();
+    const Vec<J, mc> lj = lambda.template cast<J>();
     Vec<J, N> rj;
     VecX terms;
     residual<J>(q_curr, p_curr, W, q1j, lj, &rj, &terms);
@@ -159,7 +181,7 @@ class DlaStepper {
 
   // The residual alone (no derivatives), judged with the scale of a nearby
   // Jacobian Jq (the one the chord iterations use): cheap.
-  double evaluate_value(const VecN& q_curr, const VecN& p_curr, const Mat<double, m, n>& W,
+  double evaluate_value(const VecN& q_curr, const VecN& p_curr, const Mat<double, mc, n>& W,
                         const VecN& q1, const VecM& lambda, const Mat<double, N, n>& Jq,
                         VecX* r) const {
     VecX terms;
@@ -180,22 +202,22 @@ class DlaStepper {
   // forms for n <= 4), else by pivoted LU of the whole matrix.
   class StepSolver {
    public:
-    explicit StepSolver(const Mat<double, m, n>& W) : Wt_(W.transpose()) {}
+    explicit StepSolver(const Mat<double, mc, n>& W) : Wt_(W.transpose()) {}
     void factor(const Mat<double, N, n>& Jq) {
       const Mat<double, n, n> A = Jq.template topRows<n>();
-      B_ = Jq.template bottomRows<m>();
+      B_ = Jq.template bottomRows<mc>();
       bool invertible = false;
-      if constexpr (n <= 4 && m > 0) {
+      if constexpr (n <= 4 && mc > 0) {
         // |det A| against the size of its entries, as det scales: relative 1e-10.
         A.computeInverseWithCheck(Ainv_, invertible, 1e-10 * std::pow(max_abs(A), n));
       }
-      if constexpr (m > 0) {
+      if constexpr (mc > 0) {
         if (invertible) {
-          const Mat<double, m, m> Sm = B_ * Ainv_ * Wt_;  // Schur complement B A^-1 W^T
+          const Mat<double, mc, mc> Sm = B_ * Ainv_ * Wt_;  // Schur complement B A^-1 W^T
           schur_.compute(Sm);
           schur_ok_ =
               std::isfinite(Sm.sum()) &&
-              std::abs(schur_.determinant()) > 1e-10 * std::pow(max_abs(Sm), m);
+              std::abs(schur_.determinant()) > 1e-10 * std::pow(max_abs(Sm), mc);
         } else {
           schur_ok_ = false;
         }
@@ -203,21 +225,21 @@ class DlaStepper {
       if (!schur_ok_) {
         Mat<double, N, N> K = Mat<double, N, N>::Zero();
         K.template leftCols<n>() = Jq;
-        K.template topRightCorner<n, m>() = -Wt_;
+        K.template topRightCorner<n, mc>() = -Wt_;
         lu_.compute(K);
       }
     }
     VecX solve(const VecX& r) const {
-      if constexpr (m == 0) {
+      if constexpr (mc == 0) {
         return lu_.solve(r);
       } else {
         if (!schur_ok_) return lu_.solve(r);
         // A dq - W^T dl = r1,  B dq = r2  =>  (B A^-1 W^T) dl = r2 - B A^-1 r1.
         const VecN y = Ainv_ * r.template head<n>();
-        const VecM dl = schur_.solve(VecM(r.template tail<m>() - B_ * y));
+        const VecM dl = schur_.solve(VecM(r.template tail<mc>() - B_ * y));
         VecX dx;
         dx.template head<n>() = y + Ainv_ * (Wt_ * dl);
-        dx.template tail<m>() = dl;
+        dx.template tail<mc>() = dl;
         return dx;
       }
     }
@@ -233,10 +255,10 @@ class DlaStepper {
       return x;
     }
 
-    Mat<double, n, m> Wt_;
-    Mat<double, m, n> B_;
+    Mat<double, n, mc> Wt_;
+    Mat<double, mc, n> B_;
     Mat<double, n, n> Ainv_;
-    Eigen::PartialPivLU<Mat<double, m, m>> schur_;
+    Eigen::PartialPivLU<Mat<double, mc, mc>> schur_;
     Eigen::PartialPivLU<Mat<double, N, N>> lu_;
     bool schur_ok_ = false;
   };
@@ -247,7 +269,7 @@ class DlaStepper {
     return std::abs(r) / std::max(scale, std::numeric_limits<double>::min());
   }
 
-  StepSummary newton(const VecN& q_curr, const VecN& p_curr, const Mat<double, m, n>& W,
+  StepSummary newton(const VecN& q_curr, const VecN& p_curr, const Mat<double, mc, n>& W,
                      const VecN& q_guess, const VecM& lambda_guess, VecN* q_out,
                      VecM* lambda_out) const {
     constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
@@ -285,7 +307,7 @@ class DlaStepper {
         return s;
       }
       q1 -= dx.template head<n>();
-      lambda -= dx.template tail<m>();
+      lambda -= dx.template tail<mc>();
       prev = rel;
       ++s.iterations;
       rel = evaluate_value(q_curr, p_curr, W, q1, lambda, Jq, &r);
@@ -309,13 +331,13 @@ class DlaStepper {
     const DlaStepper* self;
     const VecN* q_curr;
     const VecN* p_curr;
-    const Mat<double, m, n>* W;
+    const Mat<double, mc, n>* W;
     template <class T>
     bool operator()(const T* x, T* residuals) const {
       Vec<T, n> q1;
-      Vec<T, m> lambda;
+      Vec<T, mc> lambda;
       for (int i = 0; i < n; ++i) q1[i] = x[i];
-      for (int a = 0; a < m; ++a) lambda[a] = x[n + a];
+      for (int a = 0; a < mc; ++a) lambda[a] = x[n + a];
       Vec<T, N> r;
       self->residual(*q_curr, *p_curr, *W, q1, lambda, &r);
       for (int i = 0; i < N; ++i) residuals[i] = r[i];
@@ -323,7 +345,7 @@ class DlaStepper {
     }
   };
 
-  StepSummary tiny_solver(const VecN& q_curr, const VecN& p_curr, const Mat<double, m, n>& W,
+  StepSummary tiny_solver(const VecN& q_curr, const VecN& p_curr, const Mat<double, mc, n>& W,
                           const VecN& q_guess, const VecM& lambda_guess, VecN* q_out,
                           VecM* lambda_out) const {
     StepSummary s;
@@ -337,12 +359,12 @@ class DlaStepper {
     solver.options.cost_threshold = 0;
     VecX x;
     x.template head<n>() = q_guess;
-    x.template tail<m>() = lambda_guess;
+    x.template tail<mc>() = lambda_guess;
     const auto& summary = solver.Solve(cost, &x);
     s.iterations = summary.iterations;
     s.evaluations = summary.iterations + 1;
     const VecN q1 = x.template head<n>();
-    const VecM lambda = x.template tail<m>();
+    const VecM lambda = x.template tail<mc>();
     VecX r;
     Mat<double, N, n> Jq;
     s.relative_residual = evaluate(q_curr, p_curr, W, q1, lambda, &r, &Jq);

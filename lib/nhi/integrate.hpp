@@ -67,7 +67,7 @@ RunReport integrate_dla_from(const DlaStepper<S, D>& stepper, const Vec<double, 
   RunReport rep;
   Vec<double, n> q_prev = q0, q_curr = q0, p_curr = p0;
   Vec<double, n> q_next = q0, p_next = p_curr, guess = q0 + h * v0;
-  Vec<double, m> lambda = Vec<double, m>::Zero();
+  typename DlaStepper<S, D>::VecM lambda = DlaStepper<S, D>::VecM::Zero();  // (mu, lambda of g)
   Sample<n, m> s;
   s.has_p = true;
   for (long k = 0; k <= steps; ++k) {
@@ -91,7 +91,7 @@ RunReport integrate_dla_from(const DlaStepper<S, D>& stepper, const Vec<double, 
     s.q = q_curr;
     s.v = (k == 0) ? v0 : Vec<double, n>((q_next - q_prev) / (2 * h));
     s.p = p_curr;
-    s.lambda = lambda;
+    s.lambda = lambda.template head<m>();
     s.discrete_constraint = discrete_constraint<S, D, double>(stepper.system(),
                                                               stepper.discretization(), h, q_curr, q_next);
     if (!observe(static_cast<const Sample<n, m>&>(s))) {

@@ -10,6 +10,10 @@
 //   Vec<double,n> acceleration(const Vec<double,n>& q, const Vec<double,n>& v) const;
 // and optionally
 //   template <class T> void partials(q, v, Vec<T,n>* dLdq, Vec<T,n>* dLdv) const;
+//   static constexpr int l;  template <class T> Vec<T,l> g(const Vec<T,n>& q) const;
+// The last pair adds l holonomic constraints g(q) = 0: the Constrained Coordinate
+// Formulation (paper eq. 17), where Q is a submanifold g = 0 of a vector space V
+// and the configuration is a point of V (e.g. an angle as a unit vector).
 // acceleration() is the index-reduced ODE (constraint differentiated once, multiplier
 // eliminated, paper section 6.1) written out by hand for speed; the tests check
 // it against generic_acceleration() below, which derives it from L and omega.
@@ -34,6 +38,29 @@ struct has_partials<S, T,
                         std::declval<const Vec<T, S::n>&>(), std::declval<const Vec<T, S::n>&>(),
                         std::declval<Vec<T, S::n>*>(), std::declval<Vec<T, S::n>*>()))>>
     : std::true_type {};
+
+// Number of holonomic constraints g(q) = 0 the system declares (0 if none).
+template <class S, class = void>
+struct holonomic_count : std::integral_constant<int, 0> {};
+template <class S>
+struct holonomic_count<S, std::void_t<decltype(S::l)>> : std::integral_constant<int, S::l> {};
+
+// g(q) and its derivative Dg(q) (an l x n matrix) by one Jet.
+template <class S>
+inline Mat<double, holonomic_count<S>::value, S::n> holonomic_jacobian(const S& sys,
+                                                                        const Vec<double, S::n>& q) {
+  constexpr int n = S::n, l = holonomic_count<S>::value;
+  Mat<double, l, n> G;
+  if constexpr (l > 0) {
+    using J = ceres::Jet<double, n>;
+    Vec<J, n> qj;
+    for (int i = 0; i < n; ++i) qj[i] = J(q[i], i);
+    const Vec<J, l> gj = sys.template g<J>(qj);
+    for (int a = 0; a < l; ++a)
+      for (int i = 0; i < n; ++i) G(a, i) = gj[a].v[i];
+  }
+  return G;
+}
 
 // dL/dq and dL/dqdot at (q, v) by autodiff of L: one forward-mode Jet over the
 // 2n inputs.  T may itself be a Jet (then this is a Jet of Jets: exact, slow).

@@ -53,6 +53,19 @@ struct Particle {
     return w;
   }
 
+  // Theorem 5.3 (eq. 24) with kx = 0: translations in (x, z) are a symmetry and
+  // the section xi(q) = (1, y) has generator d/dx + y d/dz in D.  The discrete
+  // nonholonomic momentum J_k = <p_k, xi(q_k)_Q> = p_x + y p_z, and eq. (24) reads
+  // J_{k+1} - J_k = <p_{k+1}, (xi(q_{k+1}) - xi(q_k))_Q> = p_{z,k+1} (y_{k+1} - y_k).
+  // Continuous (eq. 23): d/dt (xd + y zd) = zd yd.
+  static double nonholonomic_momentum(const Vec<double, 3>& q, const Vec<double, 3>& p) {
+    return p[0] + q[1] * p[2];
+  }
+  static double momentum_equation_rhs(const Vec<double, 3>& q0, const Vec<double, 3>& q1,
+                                      const Vec<double, 3>& p1) {
+    return p1[2] * (q1[1] - q0[1]);
+  }
+
   Vec<double, 3> acceleration(const Vec<double, 3>& q, const Vec<double, 3>& v) const {
     const double y = q[1];
     const double lambda = (v[0] * v[1] - 2.0 * kx * q[0] * y) / (1.0 + y * y);

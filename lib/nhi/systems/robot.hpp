@@ -72,6 +72,16 @@ struct Robot {
     return w;
   }
 
+  // Theorem 5.3 (eq. 24) with SE(2) acting on (x, y, theta): the section with
+  // generator d/dtheta is xi(q) = (1, (y, -x)) (rotation about (x, y)), so
+  // J_k = p_theta, and xi(q_{k+1}) - xi(q_k) is the translation (dy, -dx):
+  // p_{theta,k+1} - p_{theta,k} = p_{x,k+1} (y_{k+1} - y_k) - p_{y,k+1} (x_{k+1} - x_k).
+  static double nonholonomic_momentum(const Vec<double, 4>&, const Vec<double, 4>& p) { return p[2]; }
+  static double momentum_equation_rhs(const Vec<double, 4>& q0, const Vec<double, 4>& q1,
+                                      const Vec<double, 4>& p1) {
+    return p1[0] * (q1[1] - q0[1]) - p1[1] * (q1[0] - q0[0]);
+  }
+
   Vec<double, 4> acceleration(const Vec<double, 4>& q, const Vec<double, 4>& v) const {
     const double c = std::cos(q[2]), s = std::sin(q[2]);
     const double psidd = -V0 * std::cos(q[3]) / (3.0 * Iw + mass * R * R);

@@ -1,0 +1,185 @@
+// Study 5: the geometry of the discrete flow, as series for figures.
+//  - "momentum": Theorem 5.3 (eq. 24) along DLA runs, the discrete nonholonomic
+//    momentum J_k and J_0 + sum of the right-hand sides of eq. (24), with the
+//    per-step residual: the particle with V = y^2 (kx = 0) and the robot with SE(2).
+//  - "extrinsic": the robot with its circles as unit vectors (holonomic
+//    constraints, eq. 17; systems/robot_extrinsic.hpp) against the intrinsic
+//    DLA: energy and constraint along a run, and errors at T = 2 over h.
+//  - "holonomic": Remark 3.3 on the circle, the omega-DLA and the eq.-17 (g) DLA:
+//    energy and the radius along a run.
+// Initial states come from the scene files; the tests (tests/test_geometry.cpp,
+// tests/test_embedding.cpp) assert what these series show.
+#include "nhi/systems/circle.hpp"
+#include "nhi/systems/robot_extrinsic.hpp"
+#include "study.hpp"
+
+namespace {
+
+using nhi::Vec;
+using study::json;
+
+template <int N>
+Vec<double, N> vec(const json& a) {
+  Vec<double, N> v;
+  for (int i = 0; i < N; ++i) v[i] = a.at(i).get<double>();
+  return v;
+}
+
+// Eq. (24) along a DLA run of S (which has nonholonomic_momentum / momentum_equation_rhs).
+template <class S>
+json momentum_run(const S& sys, double alpha, double h, long steps, const Vec<double, S::n>& q0,
+                  const Vec<double, S::n>& v0) {
+  const nhi::DlaStepper<S, nhi::AlphaDiscretization> st(sys, nhi::AlphaDiscretization{alpha}, h);
+  std::vector<Vec<double, S::n>> qs, ps;
+  const nhi::RunReport rep = nhi::integrate_dla(st, q0, v0, steps, [&](const nhi::Sample<S::n, S::m>& s) {
+    qs.push_back(s.q);
+    ps.push_back(s.p);
+    return true;
+  });
+  std::vector<double> t, J, Jsum, residual;
+  double acc = S::nonholonomic_momentum(qs[0], ps[0]);
+  for (size_t k = 0; k < qs.size(); ++k) {
+    t.push_back(k * h);
+    J.push_back(S::nonholonomic_momentum(qs[k], ps[k]));
+    Jsum.push_back(acc);
+    if (k + 1 < qs.size()) {
+      const double rhs = S::momentum_equation_rhs(qs[k], qs[k + 1], ps[k + 1]);
+      acc += rhs;
+      residual.push_back(std::abs(S::nonholonomic_momentum(qs[k + 1], ps[k + 1]) - J.back() - rhs));
+    }
+  }
+  json j = {{"alpha", alpha}, {"h", h}, {"t", t}, {"J", J}, {"J0_plus_sum_rhs", Jsum}, {"residual", residual},
+            {"max_residual", *std::max_element(residual.begin(), residual.end())}};
+  j["status"] = rep.ok ? "ok" : "failed";
+  if (!rep.ok) j["reason"] = rep.reason;
+  return j;
+}
+
+struct ChartRun {
+  std::vector<Vec<double, 4>> q, v;
+  double max_g = 0;
+  bool ok = true;
+};
+
+ChartRun robot_run(bool extrinsic, double h, long steps, const Vec<double, 4>& q0, const Vec<double, 4>& v0) {
+  ChartRun r;
+  const nhi::AlphaDiscretization mid{0.5};
+  if (!extrinsic) {
+    const nhi::DlaStepper<nhi::Robot, nhi::AlphaDiscretization> st(nhi::Robot{}, mid, h);
+    r.ok = nhi::integrate_dla(st, q0, v0, steps, [&](const nhi::Sample<4, 2>& s) {
+             r.q.push_back(s.q);
+             r.v.push_back(s.v);
+             return true;
+           }).ok;
+  } else {
+    using X = nhi::RobotExtrinsic;
+    const X sys;
+    const nhi::DlaStepper<X, nhi::AlphaDiscretization> st(sys, mid, h);
+    Vec<double, 4> near = q0;
+    r.ok = nhi::integrate_dla(st, X::embed(q0), X::embed_velocity(q0, v0), steps,
+                              [&](const nhi::Sample<6, 2>& s) {
+                                near = X::chart(s.q, near);
+                                r.q.push_back(near);
+                                r.v.push_back(X::chart_velocity(s.q, s.v));
+                                r.max_g = std::max(r.max_g, sys.g<double>(s.q).cwiseAbs().maxCoeff());
+                                return true;
+                              })
+               .ok;
+  }
+  return r;
+}
+
+json robot_series(const ChartRun& r, double h, const Vec<double, 4>& q0, const Vec<double, 4>& v0) {
+  const nhi::Robot sys;
+  const double E0 = nhi::energy(sys, q0, v0);
+  std::vector<double> t, dE, c;
+  double maxE = 0, maxc = 0;
+  for (size_t k = 0; k < r.q.size(); ++k) {
+    t.push_back(k * h);
+    dE.push_back(nhi::energy(sys, r.q[k], r.v[k]) - E0);
+    c.push_back(nhi::constraint_values(sys, r.q[k], r.v[k]).cwiseAbs().maxCoeff());
+    maxE = std::max(maxE, std::abs(dE.back()));
+    maxc = std::max(maxc, c.back());
+  }
+  return {{"t", t}, {"energy_error", dE}, {"constraint", c}, {"max_abs_energy_error", maxE},
+          {"max_abs_constraint", maxc}, {"max_abs_g", r.max_g}, {"status", r.ok ? "ok" : "failed"}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  study::install_signal_handlers();
+  const study::Options o = study::parse(argc, argv, "Geometry of the discrete flow: eq. 24, eq. 17, Remark 3.3");
+  json out;
+  try {
+    const json ps = study::scene(o, "particle"), rs = study::scene(o, "robot");
+    const Vec<double, 3> pq0 = vec<3>(ps["q0"]), pv0 = vec<3>(ps["v0"]);
+    const Vec<double, 4> rq0 = vec<4>(rs["q0"]), rv0 = vec<4>(rs["v0"]);
+    nhi::Particle particle;
+    particle.kx = 0.0;  // V = ky y^2: translations in (x, z) are a symmetry
+    const double h = 0.2;
+    const long steps = 2000;
+
+    std::vector<json> slots(9);
+    std::vector<std::function<void()>> tasks;
+    tasks.push_back([&] { slots[0] = momentum_run(particle, 0.5, h, steps, pq0, pv0); });
+    tasks.push_back([&] { slots[1] = momentum_run(particle, 0.25, h, steps, pq0, pv0); });
+    tasks.push_back([&] { slots[2] = momentum_run(nhi::Robot{}, 0.5, h, steps, rq0, rv0); });
+    tasks.push_back([&] { slots[3] = momentum_run(nhi::Robot{}, 0.25, h, steps, rq0, rv0); });
+    tasks.push_back([&] { slots[4] = robot_series(robot_run(false, h, steps, rq0, rv0), h, rq0, rv0); });
+    tasks.push_back([&] { slots[5] = robot_series(robot_run(true, h, steps, rq0, rv0), h, rq0, rv0); });
+    // Convergence at T = 2 against the exact reduced flow (robot.hpp).
+    tasks.push_back([&] {
+      const double T = 2.0;
+      Vec<double, 4> qT, vT;
+      nhi::Robot{}.reduced_flow(rq0, rv0, T, 200000, &qT, &vT);
+      std::vector<double> hs, ein, eex;
+      for (double hh = 0.2; hh > 0.005; hh /= 2) {
+        const long n = std::lround(T / hh);
+        hs.push_back(hh);
+        ein.push_back((robot_run(false, hh, n, rq0, rv0).q.back() - qT).cwiseAbs().maxCoeff());
+        eex.push_back((robot_run(true, hh, n, rq0, rv0).q.back() - qT).cwiseAbs().maxCoeff());
+      }
+      const std::vector<double> fh(hs.end() - 4, hs.end()), fi(ein.end() - 4, ein.end()), fe(eex.end() - 4, eex.end());
+      slots[6] = {{"T", T}, {"h", hs}, {"intrinsic", ein}, {"extrinsic", eex},
+                  {"order_intrinsic", study::loglog_slope(fh, fi)}, {"order_extrinsic", study::loglog_slope(fh, fe)},
+                  {"order_fit", "least squares over the 4 smallest h"}};
+    });
+    // Remark 3.3: the circle, omega-DLA and g-DLA (eq. 17), h = 0.1.
+    tasks.push_back([&] {
+      const double hc = 0.1;
+      const long n = 5000;
+      const Vec<double, 2> q0(std::cos(-0.3), std::sin(-0.3)), v0 = 1.7 * Vec<double, 2>(-q0[1], q0[0]);
+      const nhi::CircleParticle cp;
+      const double E0 = nhi::energy(cp, q0, v0);
+      auto series = [&](auto stepper) {
+        std::vector<double> t, dE, radius;
+        using St = decltype(stepper);
+        constexpr int m = St::m;
+        const bool ok = nhi::integrate_dla(stepper, q0, v0, n, [&](const nhi::Sample<2, m>& s) {
+                          t.push_back(s.t);
+                          dE.push_back(nhi::energy(cp, s.q, s.v) - E0);
+                          radius.push_back(s.q.norm() - 1.0);
+                          return true;
+                        }).ok;
+        return json{{"t", t}, {"energy_error", dE}, {"radius_error", radius}, {"status", ok ? "ok" : "failed"}};
+      };
+      slots[7] = {{"h", hc},
+                  {"omega", series(nhi::DlaStepper<nhi::CircleParticle, nhi::AlphaDiscretization>(
+                                cp, nhi::AlphaDiscretization{0.5}, hc))},
+                  {"g", series(nhi::DlaStepper<nhi::CircleHolonomic, nhi::AlphaDiscretization>(
+                            nhi::CircleHolonomic{}, nhi::AlphaDiscretization{0.5}, hc))}};
+    });
+    study::Progress progress("geometry", static_cast<long>(tasks.size()));
+    study::parallel_for(tasks.size(), o.threads, [&](size_t i) { tasks[i](); }, &progress);
+    out = {{"study", "geometry"},
+           {"momentum", {{"particle", {{"kx", 0.0}, {"ky", particle.ky}, {"runs", {slots[0], slots[1]}}}},
+                         {"robot", {{"runs", {slots[2], slots[3]}}}}}},
+           {"extrinsic", {{"h", h}, {"intrinsic", slots[4]}, {"extrinsic", slots[5]}, {"convergence", slots[6]}}},
+           {"holonomic", {{"circle", slots[7]}}}};
+  } catch (const std::exception& e) {
+    std::cerr << "study_geometry: error: " << e.what() << "\n";
+    return 1;
+  }
+  return study::finish(o, out);
+}
