@@ -10,11 +10,12 @@ BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2
 
-.PHONY: all deps build test test-sanitize reproduce figures clean
+.PHONY: all deps deps-fuzz build test test-sanitize fuzz reproduce figures clean
 all: build
 
-deps:
-	@missing=""; for p in $(DEB_PACKAGES); do \
+# $(call APT,packages): apt-get install those of the packages not installed yet.
+define APT
+	@missing=""; for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
 	done; \
 	if [ -n "$$missing" ]; then \
@@ -22,6 +23,15 @@ deps:
 	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -q && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -q --no-install-recommends $$missing; \
 	fi
+endef
+
+deps:
+	$(call APT,$(DEB_PACKAGES))
+
+# clang and its libFuzzer runtime, only for `make fuzz`.
+FUZZ_PACKAGES := clang libclang-rt-14-dev
+deps-fuzz: deps
+	$(call APT,$(FUZZ_PACKAGES))
 
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -42,6 +52,21 @@ test-sanitize: deps
 	  -DCMAKE_CXX_FLAGS="$(SANITIZE)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE)"
 	cmake --build $(BUILD)-sanitize -j$(JOBS)
 	UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir $(BUILD)-sanitize --output-on-failure -j$(JOBS)
+
+# libFuzzer on the scene loader and validator (tests/fuzz/fuzz_scene.cpp), with
+# ASan and UBSan, for FUZZ_SECONDS; seeds are the scene files, new inputs go to
+# $(BUILD)-fuzz/corpus.  A finding is saved as crash-*/leak-* in the current
+# directory and the target exits non-zero.
+FUZZ_SECONDS ?= 600
+FUZZ_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+fuzz: deps-fuzz
+	cmake -S . -B $(BUILD)-fuzz -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DNHI_NATIVE=OFF -DNHI_FUZZ=ON -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" \
+	  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
+	cmake --build $(BUILD)-fuzz -j$(JOBS) --target fuzz_scene
+	mkdir -p $(BUILD)-fuzz/corpus
+	$(BUILD)-fuzz/bin/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -max_len=2048 -print_final_stats=1 \
+	  -dict=tests/fuzz/scene.dict $(BUILD)-fuzz/corpus experiments/scenes tests/fuzz/regressions
 
 reproduce: build
 	$(MAKE) -j$(JOBS) figures

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -76,40 +77,129 @@ TEST_F(Cli, EveryMethodRuns) {
   }
 }
 
-TEST_F(Cli, BadInputsFailWithOneLineAndNoFile) {
-  const std::vector<std::pair<std::string, std::string>> cases = {
-      {write("trunc.json", R"({"system": "particle", "q0": [1, 0.5)"), ""},
-      {write("notobj.json", "[1, 2, 3]"), ""},
-      {scene(), "--set system=pendulum"},
-      {scene(), "--set method=euler"},
-      {scene(), "--set 'q0=[1,2]'"},
-      {scene(), "--set alpha=1.5"},
-      {scene(), "--set h=0"},
-      {scene(), "--set steps=0"},
-      {scene(), "--set steps=2.5"},
-      {scene(), "--set h=1e400"},
-      {scene(), "--set 'v0=[0.5,1,1]'"},
-      {scene(), "--set colour=3"},
-      {path("missing.json"), ""},
+// Hostile scene files through `nhi run`: each is rejected with exit 2 and one
+// line on stderr, creates no output file, and leaves an existing one as it was.
+struct BadScene {
+  const char* what;
+  std::string text;  // the scene file's contents
+  std::string set;   // extra command-line arguments
+};
+
+json particle_scene() {
+  return json::parse(R"({"system": "particle", "q0": [1, 0.5, 0], "v0": [0.5, 1, 0.25],
+                         "method": "dla", "h": 0.2, "steps": 10})");
+}
+json robot_scene() {
+  return json::parse(R"({"system": "robot", "q0": [0, 0, 0, 0], "v0": [1, 0, 1, 1],
+                         "method": "dla", "h": 0.2, "steps": 10})");
+}
+std::string edited(json s, const std::function<void(json&)>& edit) {
+  edit(s);
+  return s.dump();
+}
+// The particle scene's text with one value replaced by raw text (for non-JSON literals).
+std::string raw(const std::string& key, const std::string& value) {
+  json s = particle_scene();
+  s[key] = "@@";
+  std::string t = s.dump();
+  return t.replace(t.find("\"@@\""), 4, value);
+}
+
+std::vector<BadScene> bad_scenes() {
+  using F = std::function<void(json&)>;
+  auto P = [](const F& f) { return edited(particle_scene(), f); };
+  auto R = [](const F& f) { return edited(robot_scene(), f); };
+  return {
+      {"truncated JSON", R"({"system": "particle", "q0": [1, 0.5)", ""},
+      {"empty file", "", ""},
+      {"not an object", "[1, 2, 3]", ""},
+      {"a bare string", "\"particle\"", ""},
+      {"trailing garbage", particle_scene().dump() + " }", ""},
+      {"h a string", P([](json& s) { s["h"] = "0.2"; }), ""},
+      {"q0 a string", P([](json& s) { s["q0"] = "1 0.5 0"; }), ""},
+      {"steps a boolean", P([](json& s) { s["steps"] = true; }), ""},
+      {"h null", P([](json& s) { s["h"] = nullptr; }), ""},
+      {"q0 nested arrays", P([](json& s) { s["q0"] = json::parse("[[1], [0.5], [0]]"); }), ""},
+      {"missing system", P([](json& s) { s.erase("system"); }), ""},
+      {"missing q0", P([](json& s) { s.erase("q0"); }), ""},
+      {"missing steps", P([](json& s) { s.erase("steps"); }), ""},
+      {"unknown key", P([](json& s) { s["stepz"] = 10; }), ""},
+      {"unknown parameter", P([](json& s) { s["params"] = {{"mass", 2}}; }), ""},
+      {"params an array", P([](json& s) { s["params"] = {1, 2}; }), ""},
+      {"empty q0", P([](json& s) { s["q0"] = json::array(); }), ""},
+      {"empty v0", P([](json& s) { s["v0"] = json::array(); }), ""},
+      {"NaN literal", raw("h", "NaN"), ""},
+      {"Infinity literal", raw("h", "Infinity"), ""},
+      {"number overflowing a double", raw("h", "1e999"), ""},
+      {"huge q0 entry", raw("q0", "[1e300, 0.5, 0]"), ""},
+      {"huge parameter", P([](json& s) { s["params"] = {{"kx", 1e200}}; }), ""},
+      {"huge steps", raw("steps", "1e30"), ""},
+      {"alpha just above 1", P([](json& s) { s["alpha"] = 1.0000001; }), ""},
+      {"alpha just below 0", P([](json& s) { s["alpha"] = -1e-9; }), ""},
+      {"h zero", P([](json& s) { s["h"] = 0; }), ""},
+      {"h negative", P([](json& s) { s["h"] = -0.2; }), ""},
+      {"steps zero", P([](json& s) { s["steps"] = 0; }), ""},
+      {"steps negative", P([](json& s) { s["steps"] = -5; }), ""},
+      {"steps non-integer", P([](json& s) { s["steps"] = 2.5; }), ""},
+      {"output_every zero", P([](json& s) { s["output_every"] = 0; }), ""},
+      {"tolerance zero", P([](json& s) { s["tolerance"] = 0; }), ""},
+      {"particle q0 of length 4", P([](json& s) { s["q0"] = {1, 0.5, 0, 0}; }), ""},
+      {"particle v0 of length 2", P([](json& s) { s["v0"] = {0.5, 1}; }), ""},
+      {"robot q0 of length 3", R([](json& s) { s["q0"] = {0, 0, 0}; }), ""},
+      {"robot v0 of length 5", R([](json& s) { s["v0"] = {1, 0, 1, 1, 0}; }), ""},
+      {"particle v0 off the constraint", P([](json& s) { s["v0"] = {0.5, 1, 0.3}; }), ""},
+      {"robot v0 off the constraint", R([](json& s) { s["v0"] = {1, 0.1, 1, 1}; }), ""},
+      {"robot with a particle parameter", R([](json& s) { s["params"] = {{"kx", 1}}; }), ""},
+      {"robot with a negative mass", R([](json& s) { s["params"] = {{"m", -1}}; }), ""},
+      {"unknown system", P([](json& s) { s["system"] = "pendulum"; }), ""},
+      {"unknown method", P([](json& s) { s["method"] = "euler"; }), ""},
+      {"unknown discretization", P([](json& s) { s["discretization"] = "trapezoid"; }), ""},
+      // Bad overrides on a good scene.
+      {"--set without =", particle_scene().dump(), "--set steps"},
+      {"--set unknown key", particle_scene().dump(), "--set colour=3"},
+      {"--set h=1e400", particle_scene().dump(), "--set h=1e400"},
+      {"--set q0 too short", particle_scene().dump(), "--set 'q0=[1,2]'"},
   };
+}
+
+TEST_F(Cli, HostileScenesFailWithOneLineAndTouchNoFile) {
+  const std::vector<BadScene> cases = bad_scenes();
+  EXPECT_GE(cases.size(), 25u);
+  const std::string fresh = path("fresh.json"), existing = path("existing.json");
+  std::ofstream(existing) << "precious";
+  int i = 0;
+  for (const BadScene& c : cases) {
+    const std::string file = write("bad" + std::to_string(i++) + ".json", c.text);
+    for (const std::string& out : {fresh, existing}) {
+      const Result r = run("run " + file + " " + c.set + " -o " + out);
+      EXPECT_EQ(r.code, 2) << c.what << ": " << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.what << ": " << r.err;
+      EXPECT_EQ(r.err.rfind("nhi: error: ", 0), 0u) << c.what << ": " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(fresh)) << c.what << " created an output file";
+    std::ifstream in(existing);
+    std::stringstream text;
+    text << in.rdbuf();
+    EXPECT_EQ(text.str(), "precious") << "output clobbered by: " << c.what;
+  }
+  // No temporary files left behind.
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+}
+
+TEST_F(Cli, BadCommandLinesFailWithOneLine) {
   const std::string out = path("out.json");
   std::ofstream(out) << "precious";
-  for (const auto& [file, extra] : cases) {
-    const Result r = run("run " + file + " " + extra + " -o " + out);
-    EXPECT_EQ(r.code, 2) << file << " " << extra << ": " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_NE(r.err.find("nhi: error:"), std::string::npos) << r.err;
-    std::ifstream in(out);
-    std::string text;
-    std::getline(in, text);
-    EXPECT_EQ(text, "precious") << "output clobbered by " << file << " " << extra;
+  for (const std::string& args : {"run " + path("missing.json") + " -o " + out, "run -o " + out,
+                                  "run " + scene() + " -o " + out + " --bogus", "fly " + scene()}) {
+    const Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
   }
-  // Nothing else was left in the directory (no temporary files).
-  for (const auto& e : fs::directory_iterator(dir_)) {
-    const std::string name = e.path().filename().string();
-    EXPECT_TRUE(name == "out.json" || name == "stderr.txt" || name.size() > 5) << name;
-    EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
-  }
+  std::ifstream in(out);
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "precious");
 }
 
 TEST_F(Cli, OutputPathThatIsADirectoryOrUnwritableFails) {
@@ -129,6 +219,46 @@ TEST_F(Cli, UnconvergedStepEndsTheRunAsFailedAndKeepsTheTrajectory) {
   EXPECT_NE(j["failure"]["reason"].get<std::string>().find("did not converge"), std::string::npos);
   // A DLA point k is complete (lambda_k, v_k) only once q_{k+1} is known: none is.
   EXPECT_EQ(j["t"].size(), 0u);
+}
+
+// A whole result file with status "failed": the failing step, its reason, and
+// every point before it, consecutive (output_every = 1).
+void expect_complete_failed_run(const json& j, double h, long complete_points, const std::string& reason) {
+  EXPECT_EQ(j["status"], "failed");
+  EXPECT_NE(j["failure"]["reason"].get<std::string>().find(reason), std::string::npos) << j["failure"];
+  ASSERT_EQ(j["t"].size(), static_cast<size_t>(complete_points));
+  for (long k = 0; k < complete_points; ++k) EXPECT_DOUBLE_EQ(j["t"][k].get<double>(), k * h);
+  EXPECT_EQ(j["q"].size(), j["t"].size());
+  EXPECT_EQ(j["energy"].size(), j["t"].size());
+  EXPECT_EQ(j["summary"]["points"], complete_points);
+}
+
+TEST_F(Cli, IllPosedStepEndsTheRunAsFailedWithEveryStepBefore) {
+  // The robot at h = 1: at step 5 the DLA equations (6) have no solution near
+  // the guess (Newton and Levenberg-Marquardt both stall at a residual ~0.1).
+  const std::string out = path("ill.json");
+  const Result r = run("run " + std::string(NHI_SCENES) + "/robot.json --set h=1 --set steps=200 -o " + out);
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const json j = json::parse(std::ifstream(out));
+  const long step = j["failure"]["step"];
+  EXPECT_GT(step, 1);
+  // A DLA point k needs q_{k+1}: the failing solve for q_j leaves points 0..j-2.
+  expect_complete_failed_run(j, 1.0, step - 1, "did not converge");
+}
+
+TEST_F(Cli, NonFiniteStateEndsTheRunAsFailedWithEveryStepBefore) {
+  // RK4 far outside its stability interval overflows.
+  const std::string out = path("inf.json");
+  const Result r = run("run " + scene() + " --set method=rk4 --set h=5 --set steps=2000 -o " + out);
+  EXPECT_EQ(r.code, 3) << r.err;
+  const json j = json::parse(std::ifstream(out));
+  const long step = j["failure"]["step"];
+  EXPECT_GT(step, 1);
+  EXPECT_LT(step, 2000);
+  expect_complete_failed_run(j, 5.0, step, "non-finite");
+  for (const auto& q : j["q"])
+    for (const auto& x : q) EXPECT_TRUE(x.is_number()) << "a recorded state is not finite";
 }
 
 TEST_F(Cli, SameSceneGivesBitIdenticalResults) {

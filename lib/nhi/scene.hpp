@@ -12,6 +12,7 @@
 //   tolerance      number in (0, 1): DLA relative residual (default 1e-12),
 //                  CVODE rtol = atol for the benchmark (default 1e-12); unused by rk4
 //   output_every   integer >= 1: record steps 0, s, 2s, ... and the last (default 1)
+// Every number must be finite and at most 1e100 in magnitude.
 // Unknown keys are rejected (a misspelt key must not silently fall back to a default).
 // validate_scene() returns the resolved scene with every default filled in, or
 // throws SceneError naming the key and the problem.  run_scene() runs it and
@@ -33,6 +34,8 @@ struct SceneError : std::runtime_error {
 
 // Parse a scene file (throws SceneError on unreadable or malformed JSON).
 json load_scene_file(const std::string& path);
+// The same for scene text already in memory; `origin` names it in messages.
+json parse_scene_text(const std::string& text, const std::string& origin);
 
 // Apply one `--set key=value` override.  The value is parsed as JSON; if that
 // fails it is taken as a string (so `--set method=rk4` works).  A dotted key

@@ -24,10 +24,15 @@ inline std::string show(const json& j) {
   return s.size() > 60 ? s.substr(0, 57) + "..." : s;
 }
 
+// Largest magnitude a scene number may have: the energy multiplies a few of
+// them, and 1e100^3 is still finite, so an accepted scene cannot overflow at t = 0.
+constexpr double kMaxMagnitude = 1e100;
+
 inline double finite_number(const json& j, const std::string& key) {
   if (!j.is_number()) fail(key, "must be a number, got " + show(j));
   const double x = j.get<double>();
   if (!std::isfinite(x)) fail(key, "must be finite, got " + show(j));
+  if (std::abs(x) > kMaxMagnitude) fail(key, "must be at most 1e100 in magnitude, got " + show(j));
   return x;
 }
 

@@ -77,10 +77,14 @@ json load_scene_file(const std::string& path) {
   if (!in) throw SceneError("cannot read scene file '" + path + "'");
   std::stringstream ss;
   ss << in.rdbuf();
+  return parse_scene_text(ss.str(), "scene file '" + path + "'");
+}
+
+json parse_scene_text(const std::string& text, const std::string& origin) {
   try {
-    return json::parse(ss.str());
-  } catch (const json::parse_error& e) {
-    throw SceneError("scene file '" + path + "' is not valid JSON: " + e.what());
+    return json::parse(text);
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
+    throw SceneError(origin + " is not valid JSON: " + e.what());
   }
 }
 
