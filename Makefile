@@ -50,7 +50,7 @@ SANITIZE := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-r
 test-sanitize: deps
 	cmake -S . -B $(BUILD)-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNHI_NATIVE=OFF \
 	  -DCMAKE_CXX_FLAGS="$(SANITIZE)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE)"
-	cmake --build $(BUILD)-sanitize -j$(JOBS)
+	cmake --build $(BUILD)-sanitize -j$(JOBS) --target nhi_tests
 	UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir $(BUILD)-sanitize --output-on-failure -j$(JOBS)
 
 # libFuzzer on the scene loader and validator (tests/fuzz/fuzz_scene.cpp), with
@@ -66,7 +66,7 @@ fuzz: deps-fuzz
 	cmake --build $(BUILD)-fuzz -j$(JOBS) --target fuzz_scene
 	mkdir -p $(BUILD)-fuzz/corpus
 	$(BUILD)-fuzz/bin/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -max_len=2048 -print_final_stats=1 \
-	  -dict=tests/fuzz/scene.dict $(BUILD)-fuzz/corpus experiments/scenes tests/fuzz/regressions
+	  -dict=tests/fuzz/scene.dict $(BUILD)-fuzz/corpus experiments/scenes tests/fuzz/seeds
 
 reproduce: build
 	$(MAKE) -j$(JOBS) figures

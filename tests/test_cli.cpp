@@ -1,6 +1,7 @@
 // The `nhi run` command line, driven as a user (or an outside check) drives it:
 // exit codes, one-line errors, result files whole or absent.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -259,6 +260,55 @@ TEST_F(Cli, NonFiniteStateEndsTheRunAsFailedWithEveryStepBefore) {
   expect_complete_failed_run(j, 5.0, step, "non-finite");
   for (const auto& q : j["q"])
     for (const auto& x : q) EXPECT_TRUE(x.is_number()) << "a recorded state is not finite";
+}
+
+// Peak resident memory (kB) of one `nhi run`, from the kernel's accounting of the child.
+long peak_rss_kb(const std::vector<std::string>& args) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(NHI_BINARY)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::freopen("/dev/null", "w", stderr);
+    ::execv(NHI_BINARY, argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  rusage ru{};
+  ::wait4(pid, &status, 0, &ru);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? ru.ru_maxrss : -1;
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+#define NHI_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define NHI_ASAN 1
+#endif
+#endif
+
+TEST_F(Cli, MemoryDoesNotGrowWithTheNumberOfSteps) {
+#ifdef NHI_ASAN
+  GTEST_SKIP() << "AddressSanitizer's quarantine and shadow memory make peak RSS meaningless";
+#endif
+  // Ten times the steps with the same number of recorded points (the stride
+  // scales): the peak must not move by more than page-level noise.  Keeping
+  // anything per step (even 100 bytes) would add 90 MB to the longer run.
+  for (const char* sc : {"particle", "robot"}) {
+    const std::string file = std::string(NHI_SCENES) + "/" + sc + ".json", out = path("m.json");
+    const long a = peak_rss_kb({"run", file, "--set", "steps=100000", "--set", "output_every=10000", "-o", out});
+    const long b = peak_rss_kb({"run", file, "--set", "steps=1000000", "--set", "output_every=100000", "-o", out});
+    std::printf("    %s: peak RSS %ld kB at 1e5 steps, %ld kB at 1e6 steps (11 recorded points each)\n", sc, a, b);
+    ASSERT_GT(a, 0);
+    ASSERT_GT(b, 0);
+    EXPECT_LT(std::abs(b - a), 1024) << sc;
+    // and the summary's maxima are over every step, not just the recorded ones
+    const json j = json::parse(std::ifstream(out));
+    EXPECT_EQ(j["summary"]["points"], 11);
+    double recorded = 0;
+    for (const auto& e : j["energy"]) recorded = std::max(recorded, std::abs(e.get<double>() - j["energy"][0].get<double>()));
+    EXPECT_GE(j["summary"]["max_abs_energy_error"].get<double>(), recorded);
+  }
 }
 
 TEST_F(Cli, SameSceneGivesBitIdenticalResults) {

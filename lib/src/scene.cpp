@@ -9,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <sys/resource.h>
+
 #include "nhi/methods.hpp"
 #include "nhi/observer.hpp"
 #include "nhi/systems/particle.hpp"
@@ -22,6 +24,12 @@ using namespace scene_detail;
 const std::vector<std::string> kKeys = {"system", "params", "q0",    "v0",        "method",
                                         "discretization", "alpha", "h", "steps", "tolerance",
                                         "output_every"};
+
+long peak_rss_kb() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_maxrss;  // kilobytes on Linux
+}
 
 double cpu_seconds() {
   timespec ts{};
@@ -63,7 +71,8 @@ json run_system(const S& sys, const json& sc) {
                   {"residual_evaluations", rep.residual_evaluations},
                   {"fallback_steps", rep.fallbacks},
                   {"rhs_evaluations", rep.rhs_evaluations},
-                  {"internal_steps", rep.internal_steps}};
+                  {"internal_steps", rep.internal_steps},
+                  {"peak_rss_kb", peak_rss_kb()}};  // of the process so far, before serialization
   out["meta"] = meta();
   return out;
 }
