@@ -337,37 +337,39 @@ TEST_F(Cli, StudyResultsDoNotDependOnTheNumberOfThreads) {
 }
 
 TEST_F(Cli, InterruptedRunWritesNothing) {
-  const std::string out = path("i.json");
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const std::string sc = scene();
-    ::execl(NHI_BINARY, NHI_BINARY, "run", sc.c_str(), "--set", "steps=2000000000", "--set",
-            "output_every=100000000", "-o", out.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  // Wait until the run has claimed its temporary output (the handlers are
-  // installed before that), then interrupt it: the run itself would take minutes.
-  auto claimed = [&] {
+  for (const int sig : {SIGTERM, SIGINT}) {
+    const std::string out = path("i.json");
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const std::string sc = scene();
+      ::execl(NHI_BINARY, NHI_BINARY, "run", sc.c_str(), "--set", "steps=2000000000", "--set",
+              "output_every=100000000", "-o", out.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    // Wait until the run has claimed its temporary output (the handlers are
+    // installed before that), then interrupt it: the run itself would take minutes.
+    auto claimed = [&] {
+      for (const auto& e : fs::directory_iterator(dir_))
+        if (e.path().filename().string().find("i.json.tmp.") == 0) return true;
+      return false;
+    };
+    for (int i = 0; i < 2000 && !claimed(); ++i) ::usleep(5000);
+    if (!claimed()) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, nullptr, 0);
+      FAIL() << "the run never started";
+    }
+    ::usleep(100000);
+    ::kill(pid, sig);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << "signal " << sig;
+    EXPECT_EQ(WEXITSTATUS(status), 130) << "signal " << sig;
+    EXPECT_FALSE(fs::exists(out)) << "signal " << sig;
     for (const auto& e : fs::directory_iterator(dir_))
-      if (e.path().filename().string().find("i.json.tmp.") == 0) return true;
-    return false;
-  };
-  for (int i = 0; i < 2000 && !claimed(); ++i) ::usleep(5000);
-  if (!claimed()) {
-    ::kill(pid, SIGKILL);
-    ::waitpid(pid, nullptr, 0);
-    FAIL() << "the run never started";
+      EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
   }
-  ::usleep(100000);
-  ::kill(pid, SIGTERM);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 130);
-  EXPECT_FALSE(fs::exists(out));
-  for (const auto& e : fs::directory_iterator(dir_))
-    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
 }
 
 }  // namespace
