@@ -160,6 +160,9 @@ std::vector<BadScene> bad_scenes() {
       {"--set unknown key", particle_scene().dump(), "--set colour=3"},
       {"--set h=1e400", particle_scene().dump(), "--set h=1e400"},
       {"--set q0 too short", particle_scene().dump(), "--set 'q0=[1,2]'"},
+      // Found by make fuzz: a string value with invalid UTF-8 made the message
+      // itself throw (nlohmann type_error 316) instead of naming the key.
+      {"--set value with invalid UTF-8", particle_scene().dump(), "--set 'h=\x86\x86'"},
   };
 }
 

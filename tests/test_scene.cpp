@@ -57,6 +57,9 @@ TEST(Scene, RejectsBadInputNamingTheKey) {
       {"tolerance zero", "tolerance", [](json& s) { s["tolerance"] = 0; }},
       {"output_every zero", "output_every", [](json& s) { s["output_every"] = 0; }},
       {"NaN entry", "v0[0]", [](json& s) { s["v0"][0] = std::nan(""); }},
+      // make fuzz found this one: the message's dump() threw on invalid UTF-8.
+      {"string with invalid UTF-8 (--set fallback)", "params.kx",
+       [](json& s) { apply_override(&s, "params.kx=\x86\x86\x86"); }},
   };
   for (const auto& c : cases) {
     json s = good();

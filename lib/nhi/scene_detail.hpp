@@ -19,8 +19,10 @@ namespace nhi::scene_detail {
   throw SceneError("scene key '" + key + "': " + problem);
 }
 
+// A value for a message.  Invalid UTF-8 (possible in a --set string value,
+// which is not parsed as JSON) is replaced, not thrown on: found by make fuzz.
 inline std::string show(const json& j) {
-  std::string s = j.dump();
+  std::string s = j.dump(-1, ' ', false, json::error_handler_t::replace);
   return s.size() > 60 ? s.substr(0, 57) + "..." : s;
 }
 
