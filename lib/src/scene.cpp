@@ -107,6 +107,8 @@ void apply_override(json* scene, const std::string& assignment) {
     value = json::parse(text);
   } catch (const json::parse_error&) {
     value = text;
+  } catch (const json::exception& e) {  // out_of_range: a number like 1e999 (found by make fuzz)
+    fail(key, std::string("value does not fit a double: ") + e.what());
   }
   if (!scene->is_object()) throw SceneError("scene must be a JSON object");
   const auto dot = key.find('.');
