@@ -18,13 +18,6 @@ namespace {
 using nhi::Vec;
 using study::json;
 
-template <int N>
-Vec<double, N> vec(const json& a) {
-  Vec<double, N> v;
-  for (int i = 0; i < N; ++i) v[i] = a.at(i).get<double>();
-  return v;
-}
-
 // Eq. (24) along a DLA run of S (which has nonholonomic_momentum / momentum_equation_rhs).
 template <class S>
 json momentum_run(const S& sys, double alpha, double h, long steps, const Vec<double, S::n>& q0,
@@ -113,14 +106,14 @@ int main(int argc, char** argv) {
   json out;
   try {
     const json ps = study::scene(o, "particle"), rs = study::scene(o, "robot");
-    const Vec<double, 3> pq0 = vec<3>(ps["q0"]), pv0 = vec<3>(ps["v0"]);
-    const Vec<double, 4> rq0 = vec<4>(rs["q0"]), rv0 = vec<4>(rs["v0"]);
+    const Vec<double, 3> pq0 = nhi::scene_detail::vector_of<3>(ps["q0"], "q0"), pv0 = nhi::scene_detail::vector_of<3>(ps["v0"], "v0");
+    const Vec<double, 4> rq0 = nhi::scene_detail::vector_of<4>(rs["q0"], "q0"), rv0 = nhi::scene_detail::vector_of<4>(rs["v0"], "v0");
     nhi::Particle particle;
     particle.kx = 0.0;  // V = ky y^2: translations in (x, z) are a symmetry
     const double h = 0.2;
     const long steps = 2000;
 
-    std::vector<json> slots(9);
+    std::vector<json> slots(8);
     std::vector<std::function<void()>> tasks;
     tasks.push_back([&] { slots[0] = momentum_run(particle, 0.5, h, steps, pq0, pv0); });
     tasks.push_back([&] { slots[1] = momentum_run(particle, 0.25, h, steps, pq0, pv0); });

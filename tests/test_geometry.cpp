@@ -177,13 +177,7 @@ Eigen::MatrixXd step_map_jacobian(const S& sys, const D& disc, double h, const V
   return Dphi;
 }
 
-// Largest |entry| by a loop (Eigen's AVX-512 maxCoeff trips a false GCC 12 warning).
-inline double max_abs(const Eigen::MatrixXd& a) {
-  double x = 0;
-  for (int i = 0; i < a.rows(); ++i)
-    for (int j = 0; j < a.cols(); ++j) x = std::max(x, std::abs(a(i, j)));
-  return x;
-}
+inline double max_abs(const Eigen::MatrixXd& a) { return a.cwiseAbs().maxCoeff(); }
 
 // The canonical form dq ^ dp as a matrix: u^T Jm w.
 inline Eigen::MatrixXd canonical_form(int n) {

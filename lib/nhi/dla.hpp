@@ -197,7 +197,7 @@ class DlaStepper {
   }
 
   // Solves the linear system with the matrix (7), [A  -W^T; B  0], A = D2 D1 L_d,
-  // B = D2 omega_d, W = omega(q_k).  While A is comfortably invertible (the usual
+  // B = D2 of (omega_d [, g]), W = force_forms(q_k).  While A is comfortably invertible (the usual
   // case: A ~ -M/h) by the Schur complement on the fixed-size A (Eigen's closed
   // forms for n <= 4), else by pivoted LU of the whole matrix.
   class StepSolver {
@@ -209,7 +209,7 @@ class DlaStepper {
       bool invertible = false;
       if constexpr (n <= 4 && mc > 0) {
         // |det A| against the size of its entries, as det scales: relative 1e-10.
-        A.computeInverseWithCheck(Ainv_, invertible, 1e-10 * std::pow(max_abs(A), n));
+        A.computeInverseWithCheck(Ainv_, invertible, 1e-10 * std::pow(A.cwiseAbs().maxCoeff(), n));
       }
       if constexpr (mc > 0) {
         if (invertible) {
@@ -217,7 +217,7 @@ class DlaStepper {
           schur_.compute(Sm);
           schur_ok_ =
               std::isfinite(Sm.sum()) &&
-              std::abs(schur_.determinant()) > 1e-10 * std::pow(max_abs(Sm), mc);
+              std::abs(schur_.determinant()) > 1e-10 * std::pow(Sm.cwiseAbs().maxCoeff(), mc);
         } else {
           schur_ok_ = false;
         }
@@ -245,16 +245,6 @@ class DlaStepper {
     }
 
    private:
-    // Largest |entry| by a plain loop: Eigen's vectorized maxCoeff on a 4x4 trips a
-    // false -Wuninitialized in GCC 12's AVX-512 intrinsics under -march=native.
-    template <class M>
-    static double max_abs(const M& a) {
-      double x = 0;
-      for (int i = 0; i < a.rows(); ++i)
-        for (int j = 0; j < a.cols(); ++j) x = std::max(x, std::abs(a(i, j)));
-      return x;
-    }
-
     Mat<double, n, mc> Wt_;
     Mat<double, mc, n> B_;
     Mat<double, n, n> Ainv_;

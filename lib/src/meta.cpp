@@ -17,7 +17,7 @@ json meta() {
   std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   return {{"git_revision", NHI_GIT_REVISION},
           {"git_dirty", NHI_GIT_DIRTY},
-          #ifdef __clang__
+#ifdef __clang__
           {"compiler", std::string(__VERSION__)},  // "Debian Clang 14.0.6"
 #else
           {"compiler", std::string("g++ ") + __VERSION__},
