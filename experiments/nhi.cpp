@@ -5,18 +5,15 @@
 // by SIGINT/SIGTERM (nothing written).  The output file is written to a
 // temporary file in the same directory and renamed, so it is whole or absent.
 #include <CLI/CLI.hpp>
-#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 
-#include "nhi/integrate.hpp"
 #include "nhi/output.hpp"
 #include "nhi/scene.hpp"
+#include "nhi/signals.hpp"
 
 namespace {
-
-void on_signal(int) { nhi::interrupt_flag().store(true); }
 
 int error(const std::string& message, int code = 2) {
   std::cerr << "nhi: error: " << message << "\n";
@@ -27,8 +24,7 @@ int error(const std::string& message, int code = 2) {
 
 int main(int argc, char** argv) {
   // Handlers first: from here on an interrupt is a clean "nothing written".
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  nhi::install_interrupt_handlers();
   CLI::App app{"Nonholonomic integrators (Cortes & Martinez 2001): run one scene"};
   app.require_subcommand(1);
   auto* run = app.add_subcommand("run", "Run SCENE.json and write the result as JSON");

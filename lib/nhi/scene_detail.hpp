@@ -1,17 +1,18 @@
 // Scene plumbing shared by the runner and the study executables: JSON value
-// checks that name the key, per-system parameter parsing, and visit_system(),
-// which calls a generic lambda with the concrete system a scene names.
+// checks that name the key, per-system parameter parsing from each system's
+// parameter table, and with_system()/visit_scene(), which call a generic lambda
+// with the concrete registered system (systems/registry.hpp) a scene names.
 #pragma once
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "nhi/core.hpp"
 #include "nhi/scene.hpp"
-#include "nhi/systems/particle.hpp"
-#include "nhi/systems/robot.hpp"
+#include "nhi/systems/registry.hpp"
 
 namespace nhi::scene_detail {
 
@@ -90,51 +91,44 @@ json to_json(const Vec<double, N>& v) {
   return a;
 }
 
-// Per-system glue: parameters from JSON, defaults.  Each scene file stays free of JSON.
+// A system from the scene's `params`: its parameter table (system.hpp, Param)
+// gives the names, the defaults (the members' initial values) and the checks.
+// *resolved gets every parameter with its value.
 template <class S>
-struct SceneTraits;
-
-template <>
-struct SceneTraits<Particle> {
-  static Particle make(const json& params, json* resolved) {
-    Particle p;
-    for (const auto& [key, value] : params.items()) {
-      if (key == "kx") p.kx = finite_number(value, "params.kx");
-      else if (key == "ky") p.ky = finite_number(value, "params.ky");
-      else fail("params." + key, "unknown parameter for system \"particle\" (known: kx, ky)");
+S make_system(const json& params, json* resolved) {
+  S sys;
+  const auto table = S::parameters();
+  for (const auto& [key, value] : params.items()) {
+    const std::string k = "params." + key;
+    const Param<S>* p = nullptr;
+    for (const auto& entry : table)
+      if (key == entry.name) p = &entry;
+    if (!p) {
+      std::string known;
+      for (const auto& entry : table) known += (known.empty() ? "" : ", ") + std::string(entry.name);
+      fail(k, "unknown parameter for system \"" + std::string(S::name) + "\" (known: " + known + ")");
     }
-    *resolved = {{"kx", p.kx}, {"ky", p.ky}};
-    return p;
+    sys.*(p->member) = finite_number(value, k);
+    if (p->check == ParamCheck::kPositive && !(sys.*(p->member) > 0)) fail(k, "must be > 0, got " + show(value));
   }
-};
+  *resolved = json::object();
+  for (const auto& entry : table) (*resolved)[entry.name] = sys.*(entry.member);
+  return sys;
+}
 
-template <>
-struct SceneTraits<Robot> {
-  static Robot make(const json& params, json* resolved) {
-    Robot r;
-    for (const auto& [key, value] : params.items()) {
-      const std::string k = "params." + key;
-      if (key == "m") r.mass = finite_number(value, k);
-      else if (key == "I") r.I = finite_number(value, k);
-      else if (key == "Iw") r.Iw = finite_number(value, k);
-      else if (key == "R") r.R = finite_number(value, k);
-      else if (key == "V0") r.V0 = finite_number(value, k);
-      else fail(k, "unknown parameter for system \"robot\" (known: m, I, Iw, R, V0)");
-      if (key != "V0" && !(value.get<double>() > 0)) fail(k, "must be > 0, got " + show(value));
-    }
-    *resolved = {{"m", r.mass}, {"I", r.I}, {"Iw", r.Iw}, {"R", r.R}, {"V0", r.V0}};
-    return r;
-  }
-};
-
-// Call f(system) with the concrete system type named in the scene.
+// Call f(system) with the concrete registered system named in the scene.
 template <class F>
 auto with_system(const json& scene, json* resolved_params, F&& f) {
   const std::string name = scene.at("system").get<std::string>();
   const json params = scene.contains("params") ? scene.at("params") : json::object();
-  if (name == "particle") return f(SceneTraits<Particle>::make(params, resolved_params));
-  if (name == "robot") return f(SceneTraits<Robot>::make(params, resolved_params));
-  fail("system", "unknown system \"" + name + "\"");
+  using R = decltype(f(std::declval<const typename Front<Systems>::type&>()));
+  std::optional<R> out;
+  for_each_type(Systems{}, [&](auto tag) {
+    using S = typename decltype(tag)::type;
+    if (!out && name == S::name) out.emplace(f(make_system<S>(params, resolved_params)));
+  });
+  if (!out) fail("system", "unknown system \"" + name + "\"");
+  return std::move(*out);
 }
 
 }  // namespace nhi::scene_detail

@@ -7,16 +7,27 @@
 //   static constexpr const char* name;
 //   template <class T> T lagrangian(const Vec<T,n>& q, const Vec<T,n>& v) const;
 //   template <class T> Mat<T,m,n> omega(const Vec<T,n>& q) const;
+// A system that is a *scene* (listed in systems/registry.hpp, runnable by `nhi`
+// and every study) also has
 //   Vec<double,n> acceleration(const Vec<double,n>& q, const Vec<double,n>& v) const;
+//   static auto parameters();          // std::array of Param<S>: name, member, check
+//   static Vec<double,n> default_q0(), default_v0();   // its default initial state
 // and optionally
 //   template <class T> void partials(q, v, Vec<T,n>* dLdq, Vec<T,n>* dLdv) const;
 //   static constexpr int l;  template <class T> Vec<T,l> g(const Vec<T,n>& q) const;
-// The last pair adds l holonomic constraints g(q) = 0: the Constrained Coordinate
+// and capability declarations the tests and studies select on (traits below):
+//   static constexpr bool reversible = true;  // L, omega invariant under (q, v) -> (q, -v)
+//   shape, group                              // a Chaplygin split (reduced.hpp)
+//   nonholonomic_momentum, momentum_equation_rhs   // a symmetry for eq. (24)
+//   reduced_flow                               // an independent exact reduced description
+// The pair (l, g) adds l holonomic constraints g(q) = 0: the Constrained Coordinate
 // Formulation (paper eq. 17), where Q is a submanifold g = 0 of a vector space V
 // and the configuration is a point of V (e.g. an angle as a unit vector).
 // acceleration() is the index-reduced ODE (constraint differentiated once, multiplier
-// eliminated, paper section 6.1) written out by hand for speed; the tests check
-// it against generic_acceleration() below, which derives it from L and omega.
+// eliminated, paper section 6.1) written out by hand for speed, for RK4 and the
+// reference solution; the tests check it against generic_acceleration() below,
+// which derives it from L and omega.  (Test-only systems such as CircleHolonomic
+// need not have it.)
 // partials() is the same kind of fast path for the DLA step: without it the
 // step's Jacobian needs a Jet of Jets, about ten times slower.
 #pragma once
@@ -28,6 +39,38 @@
 #include "nhi/core.hpp"
 
 namespace nhi {
+
+// A scene parameter: its name in the scene's `params`, the member it sets, and
+// what the validator requires of it (every number must also be finite).
+enum class ParamCheck { kFinite, kPositive };
+template <class S>
+struct Param {
+  const char* name;
+  double S::*member;
+  ParamCheck check = ParamCheck::kFinite;
+};
+
+// Capabilities a system may declare (see the top of this file).
+template <class S, class = void>
+struct is_reversible : std::false_type {};
+template <class S>
+struct is_reversible<S, std::enable_if_t<S::reversible>> : std::true_type {};
+
+template <class S, class = void>
+struct has_chaplygin_split : std::false_type {};
+template <class S>
+struct has_chaplygin_split<S, std::void_t<decltype(S::shape), decltype(S::group)>> : std::true_type {};
+
+template <class S, class = void>
+struct has_momentum_equation : std::false_type {};
+template <class S>
+struct has_momentum_equation<S, std::void_t<decltype(&S::nonholonomic_momentum),
+                                            decltype(&S::momentum_equation_rhs)>> : std::true_type {};
+
+template <class S, class = void>
+struct has_reduced_flow : std::false_type {};
+template <class S>
+struct has_reduced_flow<S, std::void_t<decltype(&S::reduced_flow)>> : std::true_type {};
 
 // Does the system hand-write its partials (the optional fast path)?
 template <class S, class T, class = void>

@@ -19,7 +19,7 @@
 
 #include <array>
 
-#include "nhi/core.hpp"
+#include "nhi/system.hpp"
 
 namespace nhi {
 
@@ -31,8 +31,19 @@ struct Particle {
   static constexpr std::array<int, 2> shape{0, 1};
   static constexpr std::array<int, 1> group{2};
 
+  // L and omega are invariant under (q, v) -> (q, -v): the standard reversing symmetry.
+  static constexpr bool reversible = true;
+
   double kx = 1.0;  // potential V = kx x^2 + ky y^2
   double ky = 1.0;
+
+  // The scene's `params` (defaults: the members' initial values).
+  static auto parameters() {
+    return std::array{Param<Particle>{"kx", &Particle::kx}, Param<Particle>{"ky", &Particle::ky}};
+  }
+  // Default initial state (experiments/scenes/particle.json has the same numbers).
+  static Vec<double, 3> default_q0() { return {1.0, 0.5, 0.0}; }
+  static Vec<double, 3> default_v0() { return {0.5, 1.0, 0.25}; }
 
   template <class T>
   T lagrangian(const Vec<T, 3>& q, const Vec<T, 3>& v) const {

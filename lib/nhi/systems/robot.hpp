@@ -14,7 +14,7 @@
 //   ydd = R (sin(theta) psidd + cos(theta) thetad psid),
 // with multipliers lambda = m (xdd, ydd).  This is also the exact reduced
 // description: theta(t) = theta0 + thetad0 t, a one-degree-of-freedom pendulum-like
-// equation for psi, and x, y by quadrature (see reduced_rhs()).
+// equation for psi, and x, y by quadrature (see reduced_flow()).
 //
 // The paper gives V0 = 10, h = 0.2 and no other values.  Defaults: m = I = R = 1,
 // Iw = 1/3 (so the mass matrix is the identity), V0 = 10; q0 = (0, 0, 0, 0),
@@ -29,7 +29,7 @@
 #include <array>
 #include <cmath>
 
-#include "nhi/core.hpp"
+#include "nhi/system.hpp"
 
 namespace nhi {
 
@@ -41,11 +41,25 @@ struct Robot {
   static constexpr std::array<int, 2> shape{2, 3};
   static constexpr std::array<int, 2> group{0, 1};
 
+  // L and omega are invariant under (q, v) -> (q, -v): the standard reversing symmetry.
+  static constexpr bool reversible = true;
+
   double mass = 1.0;  // m
   double I = 1.0;
   double Iw = 1.0 / 3.0;
   double R = 1.0;
   double V0 = 10.0;
+
+  // The scene's `params` (defaults: the members' initial values).
+  static auto parameters() {
+    using P = Param<Robot>;
+    return std::array{P{"m", &Robot::mass, ParamCheck::kPositive}, P{"I", &Robot::I, ParamCheck::kPositive},
+                      P{"Iw", &Robot::Iw, ParamCheck::kPositive}, P{"R", &Robot::R, ParamCheck::kPositive},
+                      P{"V0", &Robot::V0}};
+  }
+  // Default initial state (experiments/scenes/robot.json has the same numbers).
+  static Vec<double, 4> default_q0() { return {0.0, 0.0, 0.0, 0.0}; }
+  static Vec<double, 4> default_v0() { return {1.0, 0.0, 1.0, 1.0}; }
 
   template <class T>
   T lagrangian(const Vec<T, 4>& q, const Vec<T, 4>& v) const {

@@ -1,0 +1,197 @@
+// The reference solution: SUNDIALS CVODE, variable-order variable-step Adams
+// (the family of the paper's Matlab ode113 "benchmark") with tight tolerances,
+// on the same index-reduced ODE as RK4, reported at the requested output times.
+// It stands in for the exact solution.  (The scene value "benchmark" names it
+// in the runner's contract; in the code it is the reference solution, so as not
+// to be confused with Google Benchmark.)
+//   CvodeReference      the CVODE session (advance to t_out)
+//   ReferenceStepper    the same as a stateful stepper (stepper.hpp) on the grid t_k = k h
+//   reference_solution  q(T), v(T) from (q0, v0): what tests and studies compare against
+#pragma once
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "nhi/stepper.hpp"
+#include "nhi/system.hpp"
+
+namespace nhi {
+
+struct ReferenceOptions {
+  double rtol = 1e-12;
+  double atol = 1e-12;
+  long max_steps = 2000000000L;  // per output interval (CVODE's default is 500)
+};
+
+template <class S>
+class CvodeReference {
+ public:
+  static constexpr int n = S::n;
+  using VecN = Vec<double, n>;
+
+  CvodeReference(const S& sys, double t0, const VecN& q0, const VecN& v0,
+                 ReferenceOptions opt = {})
+      : sys_(sys) {
+    if (SUNContext_Create(nullptr, &ctx_) != 0) throw std::runtime_error("SUNContext_Create failed");
+    y_ = N_VNew_Serial(2 * n, ctx_);
+    double* y = N_VGetArrayPointer(y_);
+    for (int i = 0; i < n; ++i) {
+      y[i] = q0[i];
+      y[n + i] = v0[i];
+    }
+    mem_ = CVodeCreate(CV_ADAMS, ctx_);
+    check(CVodeInit(mem_, &CvodeReference::rhs, t0, y_), "CVodeInit");
+    check(CVodeSetUserData(mem_, this), "CVodeSetUserData");
+    check(CVodeSetErrHandlerFn(mem_, &CvodeReference::on_error, this), "CVodeSetErrHandlerFn");
+    check(CVodeSStolerances(mem_, opt.rtol, opt.atol), "CVodeSStolerances");
+    nls_ = SUNNonlinSol_FixedPoint(y_, 0, ctx_);
+    check(CVodeSetNonlinearSolver(mem_, nls_), "CVodeSetNonlinearSolver");
+    check(CVodeSetMaxNumSteps(mem_, opt.max_steps), "CVodeSetMaxNumSteps");
+  }
+  CvodeReference(const CvodeReference&) = delete;
+  CvodeReference& operator=(const CvodeReference&) = delete;
+  ~CvodeReference() {
+    if (mem_) CVodeFree(&mem_);
+    if (nls_) SUNNonlinSolFree(nls_);
+    if (y_) N_VDestroy(y_);
+    if (ctx_) SUNContext_Free(&ctx_);
+  }
+
+  // Advance to t_out; false (and message()) if CVODE fails.
+  bool advance(double t_out, VecN* q, VecN* v) {
+    double t = 0;
+    const int flag = CVode(mem_, t_out, y_, &t, CV_NORMAL);
+    if (flag < 0) {
+      if (message_.empty()) message_ = "CVODE flag " + std::to_string(flag);
+      return false;
+    }
+    const double* y = N_VGetArrayPointer(y_);
+    for (int i = 0; i < n; ++i) {
+      (*q)[i] = y[i];
+      (*v)[i] = y[n + i];
+    }
+    return true;
+  }
+
+  long rhs_evaluations() const {
+    long k = 0;
+    CVodeGetNumRhsEvals(mem_, &k);
+    return k;
+  }
+  long internal_steps() const {
+    long k = 0;
+    CVodeGetNumSteps(mem_, &k);
+    return k;
+  }
+  const std::string& message() const { return message_; }
+
+ private:
+  static int rhs(double, N_Vector y, N_Vector ydot, void* user) {
+    const auto* self = static_cast<const CvodeReference*>(user);
+    const double* yy = N_VGetArrayPointer(y);
+    double* yd = N_VGetArrayPointer(ydot);
+    VecN q, v;
+    for (int i = 0; i < n; ++i) {
+      q[i] = yy[i];
+      v[i] = yy[n + i];
+    }
+    const VecN a = self->sys_.acceleration(q, v);
+    for (int i = 0; i < n; ++i) {
+      yd[i] = v[i];
+      yd[n + i] = a[i];
+    }
+    return a.allFinite() ? 0 : 1;  // recoverable: CVODE retries with a smaller step
+  }
+  static void on_error(int code, const char* module, const char* function, char* msg,
+                       void* user) {
+    auto* self = static_cast<CvodeReference*>(user);
+    if (code < 0)
+      self->message_ = std::string(module) + "/" + function + ": " + msg;
+  }
+  void check(int flag, const char* what) {
+    if (flag != 0) throw std::runtime_error(std::string(what) + " failed: " + message_);
+  }
+
+  S sys_;
+  SUNContext ctx_ = nullptr;
+  N_Vector y_ = nullptr;
+  void* mem_ = nullptr;
+  SUNNonlinearSolver nls_ = nullptr;
+  std::string message_;
+};
+
+// The reference solution as a stepper: the adaptive CVODE run reports the grid
+// t_k = k h (h must stay the same from step to step; it is only the output
+// interval).  rhs_evaluations and internal_steps are CVODE's own counts.
+template <class S>
+class ReferenceStepper {
+ public:
+  static constexpr int n = S::n, m = S::m;
+  static constexpr int lag = 0;
+  using VecN = Vec<double, n>;
+
+  explicit ReferenceStepper(const S& sys, ReferenceOptions opt = {}) : sys_(sys), opt_(opt) {}
+  const S& system() const { return sys_; }
+
+  MethodTraits traits() const {
+    MethodTraits t;
+    t.order = 12;  // maximum Adams order; error set by the tolerance
+    t.implicit = true;
+    t.adaptive = true;
+    return t;
+  }
+
+  void start(const VecN& q0, const VecN& v0) {
+    cv_ = std::make_unique<CvodeReference<S>>(sys_, 0.0, q0, v0, opt_);
+    q_ = q0;
+    v_ = v0;
+    k_ = 0;
+    rhs_ = steps_ = 0;
+  }
+
+  StepSummary step(double h) {
+    StepSummary s;
+    const bool ok = cv_->advance((k_ + 1) * h, &q_, &v_);
+    ++k_;
+    const long rhs = cv_->rhs_evaluations(), internal = cv_->internal_steps();
+    s.rhs_evaluations = rhs - rhs_;
+    s.internal_steps = internal - steps_;
+    rhs_ = rhs;
+    steps_ = internal;
+    if (!ok) {
+      s.failure = FailureKind::kSolve;
+      s.message = "CVODE failed: " + cv_->message();
+    } else if (!q_.allFinite() || !v_.allFinite()) {
+      s.failure = FailureKind::kNonFinite;
+      s.message = "state became non-finite at step " + std::to_string(k_);
+    } else {
+      s.status = SolveStatus::kConverged;
+    }
+    return s;
+  }
+
+  void sample(Sample<n, m>* s) const {
+    s->q = q_;
+    s->v = v_;
+  }
+  Vec<double, 2 * n> phase() const {
+    Vec<double, 2 * n> z;
+    z << q_, v_;
+    return z;
+  }
+
+ private:
+  S sys_;
+  ReferenceOptions opt_;
+  std::unique_ptr<CvodeReference<S>> cv_;
+  VecN q_ = VecN::Zero(), v_ = VecN::Zero();
+  long k_ = 0, rhs_ = 0, steps_ = 0;
+};
+
+}  // namespace nhi

@@ -1,0 +1,295 @@
+// The implicit solve, generic over a residual functor: Newton's method on exact
+// ceres::Jet derivatives, a Schur-complement solve that exploits multipliers
+// entering linearly, reuse of the factorization while the iteration contracts,
+// and ceres::TinySolver (Levenberg-Marquardt) as the fallback.  The shape is
+// Ceres' tiny_solver.h: a functor, nested Options, a Summary.
+//
+// A Problem has unknowns x = (y, lambda), y in R^ny and lambda in R^nl, and a
+// residual of saddle-point form
+//     r(y, lambda) = ( f(y) - Wt lambda ,  g(y) )        (ny + nl rows)
+// with Wt a fixed ny x nl matrix during the solve (nl = 0 is a plain system).
+// The DLA step (dla.hpp, eq. 6) is of this form with y = q_{k+1} and
+// Wt = omega(q_k)^T; its Jacobian is the matrix (7).  A Problem provides
+//   static constexpr int ny, nl;
+//   const Mat<double, ny, nl>& Wt() const;
+//   template <class T> void residual(const Vec<T,ny>& y, const Vec<T,nl>& lambda,
+//                                    Vec<T,ny+nl>* r, Vec<double,ny+nl>* terms) const;
+//   Vec<double, ny> y_scale(const Vec<double, ny>& y) const;
+// residual() is called with T = double and T = ceres::Jet<double, ny> (y seeded,
+// lambda constant) and, in the fallback, Jets over all ny + nl unknowns; `terms`
+// (may be null) gets per row the sum of magnitudes of what r_i adds up.  The
+// relative residual of row i is |r_i| / (terms_i + sum_j |dr_i/dy_j| y_scale_j):
+// the second part is the residual a unit relative change of y causes, so the
+// floor it sets is the round-off of y itself (e.g. in (q1 - q0)/h when |q| is large).
+#pragma once
+
+#include <ceres/tiny_solver.h>
+#include <ceres/tiny_solver_autodiff_function.h>
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "nhi/stepper.hpp"
+
+namespace nhi {
+
+struct SolverOptions {
+  double tolerance = 1e-12;  // required relative residual
+  int max_iterations = 20;   // Newton iterations before the fallback
+  bool fallback = true;      // retry a failed Newton with ceres::TinySolver
+};
+
+template <class P>
+class NewtonSolver {
+ public:
+  static constexpr int ny = P::ny, nl = P::nl, N = ny + nl;
+  using VecY = Vec<double, ny>;
+  using VecL = Vec<double, nl>;
+  using VecX = Vec<double, N>;
+  using Options = SolverOptions;
+  using Summary = StepSummary;
+
+  explicit NewtonSolver(const P& problem, Options options = {}) : p_(problem), options_(options) {}
+
+  // Solve from (y, lambda) in place; on failure y and lambda keep the guess.
+  Summary solve(VecY* y, VecL* lambda) const {
+    Summary s = newton(y, lambda);
+    if (s.status != SolveStatus::kConverged && options_.fallback) {
+      Summary f = tiny_solver(y, lambda);
+      f.iterations += s.iterations;
+      f.evaluations += s.evaluations;
+      f.used_fallback = true;
+      if (f.status != SolveStatus::kConverged) {
+        f.message = "Newton: " + s.message + "; TinySolver fallback: " + f.message;
+        f.failure = s.failure == FailureKind::kNonFinite ? FailureKind::kNonFinite : FailureKind::kSolve;
+      }
+      s = f;
+    }
+    return s;
+  }
+
+  // Relative residual at (y, lambda); *r_out gets the residual.
+  double relative_residual(const VecY& y, const VecL& lambda, VecX* r_out = nullptr) const {
+    VecX r;
+    Mat<double, N, ny> Jy;
+    const double rel = evaluate(y, lambda, &r, &Jy);
+    if (r_out) *r_out = r;
+    return rel;
+  }
+
+ private:
+  static double ratio(double r, double scale) {
+    if (!std::isfinite(r) || !std::isfinite(scale)) return std::numeric_limits<double>::infinity();
+    if (r == 0) return 0;
+    return std::abs(r) / std::max(scale, std::numeric_limits<double>::min());
+  }
+
+  // Residual and its y-Jacobian by one Jet evaluation; returns the relative residual.
+  double evaluate(const VecY& y, const VecL& lambda, VecX* r, Mat<double, N, ny>* Jy) const {
+    using J = ceres::Jet<double, ny>;
+    Vec<J, ny> yj;
+    for (int i = 0; i < ny; ++i) yj[i] = J(y[i], i);
+    const Vec<J, nl> lj = lambda.template cast<J>();
+    Vec<J, N> rj;
+    VecX terms;
+    p_.template residual<J>(yj, lj, &rj, &terms);
+    const VecY ys = p_.y_scale(y);
+    double rel = 0;
+    for (int i = 0; i < N; ++i) {
+      (*r)[i] = rj[i].a;
+      double scale = terms[i];
+      for (int j = 0; j < ny; ++j) {
+        (*Jy)(i, j) = rj[i].v[j];
+        scale += std::abs(rj[i].v[j]) * ys[j];
+      }
+      rel = std::max(rel, ratio((*r)[i], scale));
+    }
+    return rel;
+  }
+
+  // The residual alone (no derivatives), judged with the scale of a nearby
+  // Jacobian Jy (the one the chord iterations use): cheap.
+  double evaluate_value(const VecY& y, const VecL& lambda, const Mat<double, N, ny>& Jy, VecX* r) const {
+    VecX terms;
+    p_.template residual<double>(y, lambda, r, &terms);
+    const VecY ys = p_.y_scale(y);
+    double rel = 0;
+    for (int i = 0; i < N; ++i) {
+      double scale = terms[i];
+      for (int j = 0; j < ny; ++j) scale += std::abs(Jy(i, j)) * ys[j];
+      rel = std::max(rel, ratio((*r)[i], scale));
+    }
+    return rel;
+  }
+
+  // Solves the linear system with the matrix [A  -Wt; B  0], A = df/dy, B = dg/dy.
+  // While A is comfortably invertible (for the DLA A ~ -M/h) by the Schur
+  // complement on the fixed-size A (Eigen's closed forms for ny <= 4), else by
+  // pivoted LU of the whole matrix.
+  class LinearSolver {
+   public:
+    explicit LinearSolver(const Mat<double, ny, nl>& Wt) : Wt_(Wt) {}
+    void factor(const Mat<double, N, ny>& Jy) {
+      const Mat<double, ny, ny> A = Jy.template topRows<ny>();
+      B_ = Jy.template bottomRows<nl>();
+      bool invertible = false;
+      if constexpr (ny <= 4 && nl > 0) {
+        // |det A| against the size of its entries, as det scales: relative 1e-10.
+        A.computeInverseWithCheck(Ainv_, invertible, 1e-10 * std::pow(A.cwiseAbs().maxCoeff(), ny));
+      }
+      if constexpr (nl > 0) {
+        if (invertible) {
+          const Mat<double, nl, nl> Sm = B_ * Ainv_ * Wt_;  // Schur complement B A^-1 Wt
+          schur_.compute(Sm);
+          schur_ok_ = std::isfinite(Sm.sum()) &&
+                      std::abs(schur_.determinant()) > 1e-10 * std::pow(Sm.cwiseAbs().maxCoeff(), nl);
+        } else {
+          schur_ok_ = false;
+        }
+      }
+      if (!schur_ok_) {
+        Mat<double, N, N> K = Mat<double, N, N>::Zero();
+        K.template leftCols<ny>() = Jy;
+        K.template topRightCorner<ny, nl>() = -Wt_;
+        lu_.compute(K);
+      }
+    }
+    VecX solve(const VecX& r) const {
+      if constexpr (nl == 0) {
+        return lu_.solve(r);
+      } else {
+        if (!schur_ok_) return lu_.solve(r);
+        // A dy - Wt dl = r1,  B dy = r2  =>  (B A^-1 Wt) dl = r2 - B A^-1 r1.
+        const VecY z = Ainv_ * r.template head<ny>();
+        const VecL dl = schur_.solve(VecL(r.template tail<nl>() - B_ * z));
+        VecX dx;
+        dx.template head<ny>() = z + Ainv_ * (Wt_ * dl);
+        dx.template tail<nl>() = dl;
+        return dx;
+      }
+    }
+
+   private:
+    Mat<double, ny, nl> Wt_;
+    Mat<double, nl, ny> B_;
+    Mat<double, ny, ny> Ainv_;
+    Eigen::PartialPivLU<Mat<double, nl, nl>> schur_;
+    Eigen::PartialPivLU<Mat<double, N, N>> lu_;
+    bool schur_ok_ = false;
+  };
+
+  // Newton with the Jacobian refreshed only when the last step contracted the
+  // residual by less than 1e-3 (otherwise the factorization is reused): near
+  // round-off the converged iterate is the same, with fewer Jet passes.
+  // Converged: within tolerance, and at round-off or no longer improving.
+  Summary newton(VecY* y_io, VecL* lambda_io) const {
+    constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
+    Summary s;
+    VecY y = *y_io;
+    VecL lambda = *lambda_io;
+    double prev = std::numeric_limits<double>::infinity();
+    VecX r;
+    Mat<double, N, ny> Jy;
+    LinearSolver solver(p_.Wt());
+    bool fresh = true;  // r, Jy were just evaluated with derivatives at the iterate
+    double rel = evaluate(y, lambda, &r, &Jy);
+    ++s.evaluations;
+    for (int it = 0;; ++it) {
+      s.relative_residual = rel;
+      if (!std::isfinite(rel)) {
+        s.message = "non-finite residual";
+        s.failure = FailureKind::kNonFinite;
+        return s;
+      }
+      if (rel <= options_.tolerance && (rel <= kRoundoff || rel > 0.5 * prev)) break;
+      if (it == options_.max_iterations) {
+        if (rel <= options_.tolerance) break;
+        s.message = "no convergence in " + std::to_string(it) + " iterations (relative residual " +
+                    std::to_string(rel) + ")";
+        s.failure = FailureKind::kSolve;
+        return s;
+      }
+      if (fresh) solver.factor(Jy);
+      const VecX dx = solver.solve(r);
+      if (!dx.allFinite()) {
+        s.message = "singular step matrix (eq. 7)";
+        s.failure = FailureKind::kSolve;
+        return s;
+      }
+      y -= dx.template head<ny>();
+      lambda -= dx.template tail<nl>();
+      prev = rel;
+      ++s.iterations;
+      rel = evaluate_value(y, lambda, Jy, &r);
+      ++s.evaluations;
+      fresh = false;
+      if (!(rel <= 1e-3 * prev) && !(rel <= kRoundoff)) {  // slow contraction: refresh the Jacobian
+        rel = evaluate(y, lambda, &r, &Jy);
+        ++s.evaluations;
+        fresh = true;
+      }
+    }
+    *y_io = y;
+    *lambda_io = lambda;
+    s.status = SolveStatus::kConverged;
+    return s;
+  }
+
+  // The same residual for ceres::TinySolverAutoDiffFunction (all N unknowns).
+  struct Functor {
+    enum { NUM_RESIDUALS = N, NUM_PARAMETERS = N };
+    const P* problem;
+    template <class T>
+    bool operator()(const T* x, T* residuals) const {
+      Vec<T, ny> y;
+      Vec<T, nl> lambda;
+      for (int i = 0; i < ny; ++i) y[i] = x[i];
+      for (int a = 0; a < nl; ++a) lambda[a] = x[ny + a];
+      Vec<T, N> r;
+      problem->template residual<T>(y, lambda, &r, nullptr);
+      for (int i = 0; i < N; ++i) residuals[i] = r[i];
+      return true;
+    }
+  };
+
+  Summary tiny_solver(VecY* y_io, VecL* lambda_io) const {
+    Summary s;
+    Functor f{&p_};
+    ceres::TinySolverAutoDiffFunction<Functor, N, N> cost(f);  // keeps a reference to f
+    ceres::TinySolver<ceres::TinySolverAutoDiffFunction<Functor, N, N>> solver;
+    solver.options.max_num_iterations = 200;
+    solver.options.gradient_tolerance = 0;
+    solver.options.parameter_tolerance = 1e-15;  // relative step below round-off: stop
+    solver.options.function_tolerance = 0;       // (2.1: this one is absolute)
+    solver.options.cost_threshold = 0;
+    VecX x;
+    x.template head<ny>() = *y_io;
+    x.template tail<nl>() = *lambda_io;
+    const auto& summary = solver.Solve(cost, &x);
+    s.iterations = summary.iterations;
+    s.evaluations = summary.iterations + 1;
+    const VecY y = x.template head<ny>();
+    const VecL lambda = x.template tail<nl>();
+    VecX r;
+    Mat<double, N, ny> Jy;
+    s.relative_residual = evaluate(y, lambda, &r, &Jy);
+    if (std::isfinite(s.relative_residual) && s.relative_residual <= options_.tolerance) {
+      *y_io = y;
+      *lambda_io = lambda;
+      s.status = SolveStatus::kConverged;
+    } else {
+      s.message = "relative residual " + std::to_string(s.relative_residual) + " after " +
+                  std::to_string(summary.iterations) + " iterations";
+      s.failure = FailureKind::kSolve;
+    }
+    return s;
+  }
+
+  const P& p_;
+  Options options_;
+};
+
+}  // namespace nhi

@@ -1,0 +1,119 @@
+// The *stepper* role's shared vocabulary: what one step reports (StepSummary),
+// what a method declares about itself (MethodTraits), what a stepper reports of
+// a time point (Sample), and what a whole run reports (RunReport).
+//
+// A stepper is a plain stateful type (no base class) with
+//   static constexpr int n, m;          // dim Q, number of constraint forms omega
+//   static constexpr int lag;           // 0: the point reported is the newest one;
+//                                       // 1: point k is reported once step k+1 is
+//                                       //    known (the DLA's central-difference v_k)
+//   MethodTraits traits() const;
+//   void start(const Vec<double,n>& q0, const Vec<double,n>& v0);
+//   StepSummary step(double h);         // advance by h (h < 0 is allowed)
+//   void sample(Sample<n,m>* s) const;  // fill q, v (and p, lambda, ...) of the reported point
+// and is driven by the one loop in integrate.hpp.  methods.hpp makes steppers by
+// name.  See dla.hpp, rk4.hpp and reference.hpp for the three families.
+#pragma once
+
+#include <atomic>
+#include <string>
+#include <utility>
+
+#include "nhi/core.hpp"
+
+namespace nhi {
+
+enum class SolveStatus { kConverged, kFailed };
+
+// Why a step or a run stopped.  Studies classify failures by this, never by
+// matching message text.
+enum class FailureKind {
+  kNone,
+  kSolve,        // an implicit solve did not converge (or the step matrix was singular)
+  kNonFinite,    // a state, residual or momentum became non-finite
+  kInterrupted,  // SIGINT/SIGTERM (interrupt_flag())
+  kObserver,     // the observer asked to stop
+};
+
+inline const char* to_string(FailureKind k) {
+  switch (k) {
+    case FailureKind::kNone: return "none";
+    case FailureKind::kSolve: return "solve";
+    case FailureKind::kNonFinite: return "non-finite";
+    case FailureKind::kInterrupted: return "interrupted";
+    case FailureKind::kObserver: return "observer";
+  }
+  return "?";
+}
+
+// One step (or one implicit solve): converged or failed and why, and its cost.
+struct StepSummary {
+  SolveStatus status = SolveStatus::kFailed;
+  FailureKind failure = FailureKind::kNone;  // when failed
+  int iterations = 0;            // Newton iterations (plus the fallback's, if it ran)
+  int evaluations = 0;           // residual(+Jacobian) evaluations
+  double relative_residual = 0;  // final max_i |r_i| / size of the terms of r_i
+  bool used_fallback = false;
+  long rhs_evaluations = 0;      // explicit methods and the reference solution
+  long internal_steps = 0;       // adaptive methods
+  std::string message;           // why it failed, when it did
+  bool ok() const { return status == SolveStatus::kConverged; }
+};
+
+// What a method declares about itself; tests and studies read these instead of
+// hard-coding expectations.
+struct MethodTraits {
+  int order = 0;                  // global order of q on smooth problems
+  bool symmetric = false;         // self-adjoint: a step of h then of -h returns to the start
+  bool symmetric_in_phase = true; // ... in (q, p) or (q, v); false: in q only (the DLA, see dla.hpp)
+  bool holds_velocity_constraint = false;  // omega(q_k) v_k = 0 at grid points to round-off
+  bool implicit = false;
+  bool adaptive = false;          // h is only the output interval
+};
+
+// One reported time point.
+template <int n, int m>
+struct Sample {
+  long k = 0;
+  double t = 0;
+  Vec<double, n> q = Vec<double, n>::Zero(), v = Vec<double, n>::Zero();
+  bool has_p = false;  // DLA: p_k = D2 L_d(q_{k-1}, q_k) and lambda_k of the step k -> k+1
+  Vec<double, n> p = Vec<double, n>::Zero();
+  Vec<double, m> lambda = Vec<double, m>::Zero();
+  Vec<double, m> discrete_constraint = Vec<double, m>::Zero();  // DLA: omega_d(q_k, q_{k+1})
+};
+
+struct RunReport {
+  bool ok = true;
+  long failure_step = -1;  // index j of the first time point that could not be computed
+  FailureKind failure = FailureKind::kNone;
+  std::string reason;
+  long steps_taken = 0;  // completed steps (for the DLA, including the extra one)
+  long newton_iterations = 0;
+  long residual_evaluations = 0;
+  long fallbacks = 0;        // implicit steps that needed the fallback solver
+  long rhs_evaluations = 0;  // explicit methods and the reference solution
+  long internal_steps = 0;   // adaptive methods
+  void fail(long step, FailureKind kind, std::string why) {
+    ok = false;
+    failure_step = step;
+    failure = kind;
+    reason = std::move(why);
+  }
+  void add(const StepSummary& s) {
+    newton_iterations += s.iterations;
+    residual_evaluations += s.evaluations;
+    fallbacks += s.used_fallback ? 1 : 0;
+    rhs_evaluations += s.rhs_evaluations;
+    internal_steps += s.internal_steps;
+  }
+};
+
+// Set (from the signal handler, see install_interrupt_handlers()) to make every
+// loop stop at its next step.
+inline std::atomic<bool>& interrupt_flag() {
+  static std::atomic<bool> flag{false};
+  return flag;
+}
+
+}  // namespace nhi

@@ -1,0 +1,26 @@
+// The system registry: every scene the runner, the studies and the typed tests
+// know, in one list.  Adding a scene is one header in systems/ (see system.hpp
+// for what a scene provides) and one entry here; the scene parser, the list of
+// system names, parameter defaults and validation, default states, the typed
+// test lists and every study's list of scenes all derive from `Systems`.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nhi/systems/particle.hpp"
+#include "nhi/systems/robot.hpp"
+#include "nhi/typelist.hpp"
+
+namespace nhi {
+
+using Systems = TypeList<Particle, Robot>;
+
+inline std::vector<std::string> registered_system_names() {
+  std::vector<std::string> names;
+  for_each_type(Systems{}, [&](auto tag) { names.push_back(decltype(tag)::type::name); });
+  return names;
+}
+
+}  // namespace nhi
