@@ -1,18 +1,19 @@
-// Micro-benchmarks (Google Benchmark): nanoseconds per step of each method on
-// each scene, and for the particle a hand-derived Newton step with the analytic
-// Jacobian (the floor the library's DLA step is measured against, as a ratio in
-// the same run).  Writes results/step_costs.json:  bench_steps -o FILE [google
+// Micro-benchmarks (Google Benchmark): nanoseconds per step of each "main"
+// fixed-step study method on each registered scene (the stepper as the
+// integrate loop drives it), the reference solution per run, and for the
+// particle a hand-derived Newton step with the analytic Jacobian (the floor the
+// library's DLA map is measured against, as a ratio in the same run).  Writes results/step_costs.json:  bench_steps -o FILE [google
 // benchmark flags].  Steps cycle through states of a real trajectory.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstring>
 #include <iostream>
 
 #include "nhi/methods.hpp"
 #include "nhi/output.hpp"
 #include "nhi/scene.hpp"
-#include "nhi/systems/particle.hpp"
-#include "nhi/systems/robot.hpp"
+#include "nhi/systems/registry.hpp"
 
 namespace {
 
@@ -21,26 +22,49 @@ using nhi::Vec;
 constexpr double kH = 0.2;
 constexpr int kStates = 256;
 
-// The initial state of the scene file experiments/scenes/<system>.json (run from
-// the repository root, as `make reproduce` does).
+// Steps of a library method from the system's default state, restarted every
+// 10^4 steps to stay on a bounded stretch of trajectory.  The method is chosen
+// by name once, outside the timed loop.
 template <class S>
-void scene_state(Vec<double, S::n>* q, Vec<double, S::n>* v) {
-  static const nhi::json scene =
-      nhi::validate_scene(nhi::load_scene_file(std::string("experiments/scenes/") + S::name + ".json"));
-  for (int i = 0; i < S::n; ++i) {
-    (*q)[i] = scene["q0"][i].get<double>();
-    (*v)[i] = scene["v0"][i].get<double>();
-  }
+void BM_Method(benchmark::State& state, nhi::MethodSpec spec) {
+  const S sys;
+  const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
+  nhi::with_stepper(sys, spec, [&](auto& st) {
+    st.start(q0, v0);
+    long k = 0, iterations = 0;
+    for (auto _ : state) {
+      const nhi::StepSummary s = st.step(kH);
+      iterations += s.iterations;
+      benchmark::DoNotOptimize(s);
+      if (++k % 10000 == 0) st.start(q0, v0);
+    }
+    state.counters["newton_iterations_per_step"] = double(iterations) / double(state.iterations());
+    return 0;
+  });
 }
 
-// States (q_k, p_k, guess_k, lambda_k) along a DLA trajectory.
+// The reference solution (tol 1e-12): cost per run to T = 200, and its internal steps.
+template <class S>
+void BM_Reference(benchmark::State& state) {
+  const S sys;
+  const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
+  long internal = 0;
+  for (auto _ : state) {
+    const nhi::RunReport rep = nhi::integrate(nhi::ReferenceStepper<S>(sys), q0, v0, 200.0, 1,
+                                              [](const auto&) { return true; });
+    internal += rep.internal_steps;
+  }
+  state.counters["internal_steps_per_run"] = double(internal) / double(state.iterations());
+  state.SetItemsProcessed(internal);
+}
+
+// States (q_k, p_k, guess_k, lambda_k) along a DLA trajectory, for the floor comparison.
 template <class S, class D>
 struct Trajectory {
   std::vector<Vec<double, S::n>> q, p, guess;
   std::vector<Vec<double, S::m>> lambda;
-  explicit Trajectory(const nhi::DlaStepper<S, D>& st) {
-    Vec<double, S::n> q0, v0;
-    scene_state<S>(&q0, &v0);
+  explicit Trajectory(const nhi::DlaMap<S, D>& st) {
+    const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
     Vec<double, S::n> qc = q0, pc = nhi::momentum(st.system(), q0, v0), g = q0 + kH * v0, qn = q0, pn = pc;
     Vec<double, S::m> l = Vec<double, S::m>::Zero();
     for (int k = 0; k < kStates; ++k) {
@@ -53,10 +77,11 @@ struct Trajectory {
   }
 };
 
+// The library's DLA map on the same states as the floor.
 template <class S, class D>
-void BM_Dla(benchmark::State& state, D disc) {
+void BM_DlaMap(benchmark::State& state, D disc) {
   const S sys;
-  const nhi::DlaStepper<S, D> st(sys, disc, kH);
+  const nhi::DlaMap<S, D> st(sys, disc, kH);
   const Trajectory<S, D> tr(st);
   Vec<double, S::n> qn, pn;
   Vec<double, S::m> l;
@@ -68,36 +93,6 @@ void BM_Dla(benchmark::State& state, D disc) {
     benchmark::DoNotOptimize(qn);
     k = (k + 1) % kStates;
   }
-}
-
-template <class S>
-void BM_Rk4(benchmark::State& state) {
-  const S sys;
-  const nhi::Rk4Stepper<S> st(sys, kH);
-  Vec<double, S::n> q, v;
-  scene_state<S>(&q, &v);
-  long k = 0;
-  for (auto _ : state) {
-    st.step(&q, &v);
-    benchmark::DoNotOptimize(q);
-    if (++k % 10000 == 0) scene_state<S>(&q, &v);  // stay on a bounded stretch of trajectory
-  }
-}
-
-// CVODE (tol 1e-12): cost per internal step, from runs to T = 200.
-template <class S>
-void BM_Cvode(benchmark::State& state) {
-  const S sys;
-  Vec<double, S::n> q0, v0;
-  scene_state<S>(&q0, &v0);
-  long internal = 0;
-  for (auto _ : state) {
-    const nhi::RunReport rep = nhi::integrate_benchmark(sys, 200.0, q0, v0, 1, nhi::BenchmarkOptions{},
-                                                        [](const auto&) { return true; });
-    internal += rep.internal_steps;
-  }
-  state.counters["internal_steps_per_run"] = double(internal) / double(state.iterations());
-  state.SetItemsProcessed(internal);
 }
 
 // The floor: the particle's midpoint DLA step (eq. 6 with alpha = 1/2) by hand,
@@ -144,7 +139,7 @@ struct AnalyticParticleStep {
 
 void BM_AnalyticFloor(benchmark::State& state) {
   const nhi::Particle sys;
-  const nhi::DlaStepper<nhi::Particle, nhi::AlphaDiscretization> st(sys, nhi::AlphaDiscretization{0.5}, kH);
+  const nhi::DlaMap<nhi::Particle, nhi::AlphaDiscretization> st(sys, nhi::AlphaDiscretization{0.5}, kH);
   const Trajectory<nhi::Particle, nhi::AlphaDiscretization> tr(st);
   const AnalyticParticleStep an{kH};
   Eigen::Vector3d qn, pn;
@@ -176,20 +171,25 @@ class Capture : public benchmark::ConsoleReporter {
 
 }  // namespace
 
+// One row per registered scene and fixed-step study method, plus the
+// reference solution per run, plus the particle's floor comparison.
 void register_all() {
-  using P = nhi::Particle;
-  using R = nhi::Robot;
-  using A = nhi::AlphaDiscretization;
-  using Y = nhi::SymmetricDiscretization;
   benchmark::RegisterBenchmark("particle/analytic_newton_floor", BM_AnalyticFloor);
-  benchmark::RegisterBenchmark("particle/dla_alpha0.5", [](benchmark::State& st) { BM_Dla<P, A>(st, A{0.5}); });
-  benchmark::RegisterBenchmark("particle/dla_symmetric0", [](benchmark::State& st) { BM_Dla<P, Y>(st, Y{0.0}); });
-  benchmark::RegisterBenchmark("particle/rk4", BM_Rk4<P>);
-  benchmark::RegisterBenchmark("particle/cvode_run_T200", BM_Cvode<P>)->Unit(benchmark::kMillisecond);
-  benchmark::RegisterBenchmark("robot/dla_alpha0.5", [](benchmark::State& st) { BM_Dla<R, A>(st, A{0.5}); });
-  benchmark::RegisterBenchmark("robot/dla_symmetric0", [](benchmark::State& st) { BM_Dla<R, Y>(st, Y{0.0}); });
-  benchmark::RegisterBenchmark("robot/rk4", BM_Rk4<R>);
-  benchmark::RegisterBenchmark("robot/cvode_run_T200", BM_Cvode<R>)->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("particle/dla_map_alpha0.5", [](benchmark::State& st) {
+    BM_DlaMap<nhi::Particle, nhi::AlphaDiscretization>(st, nhi::AlphaDiscretization{0.5});
+  });
+  nhi::for_each_type(nhi::Systems{}, [](auto tag) {
+    using S = typename decltype(tag)::type;
+    for (const nhi::StudyMethod& m : nhi::study_methods()) {
+      if (m.external || m.spec.kind == "benchmark" || m.group != "main") continue;
+      std::string name = std::string(S::name) + "/" + m.label();
+      std::replace(name.begin(), name.end(), ' ', '_');
+      const nhi::MethodSpec spec = m.spec;
+      benchmark::RegisterBenchmark(name.c_str(), [spec](benchmark::State& st) { BM_Method<S>(st, spec); });
+    }
+    benchmark::RegisterBenchmark((std::string(S::name) + "/reference_run_T200").c_str(), BM_Reference<S>)
+        ->Unit(benchmark::kMillisecond);
+  });
 }
 
 int main(int argc, char** argv) {
@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
     return std::nan("");
   };
   nhi::json result = {{"study", "step_costs"}, {"benchmarks", rep.rows}};
-  const double floor = ns("particle/analytic_newton_floor"), dla = ns("particle/dla_alpha0.5");
+  const double floor = ns("particle/analytic_newton_floor"), dla = ns("particle/dla_map_alpha0.5");
   result["particle_dla_over_floor"] = std::isfinite(floor) && std::isfinite(dla) ? nhi::json(dla / floor) : nhi::json(nullptr);
   result["target_ratio"] = 2.0;
   result["meta"] = nhi::meta();

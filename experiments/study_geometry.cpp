@@ -22,9 +22,9 @@ using study::json;
 template <class S>
 json momentum_run(const S& sys, double alpha, double h, long steps, const Vec<double, S::n>& q0,
                   const Vec<double, S::n>& v0) {
-  const nhi::DlaStepper<S, nhi::AlphaDiscretization> st(sys, nhi::AlphaDiscretization{alpha}, h);
+  nhi::DlaStepper<S, nhi::AlphaDiscretization> st(sys, nhi::AlphaDiscretization{alpha});
   std::vector<Vec<double, S::n>> qs, ps;
-  const nhi::RunReport rep = nhi::integrate_dla(st, q0, v0, steps, [&](const nhi::Sample<S::n, S::m>& s) {
+  const nhi::RunReport rep = nhi::integrate(st, q0, v0, h, steps, [&](const nhi::Sample<S::n, S::m>& s) {
     qs.push_back(s.q);
     ps.push_back(s.p);
     return true;
@@ -58,8 +58,8 @@ ChartRun robot_run(bool extrinsic, double h, long steps, const Vec<double, 4>& q
   ChartRun r;
   const nhi::AlphaDiscretization mid{0.5};
   if (!extrinsic) {
-    const nhi::DlaStepper<nhi::Robot, nhi::AlphaDiscretization> st(nhi::Robot{}, mid, h);
-    r.ok = nhi::integrate_dla(st, q0, v0, steps, [&](const nhi::Sample<4, 2>& s) {
+    nhi::DlaStepper<nhi::Robot, nhi::AlphaDiscretization> st(nhi::Robot{}, mid);
+    r.ok = nhi::integrate(st, q0, v0, h, steps, [&](const nhi::Sample<4, 2>& s) {
              r.q.push_back(s.q);
              r.v.push_back(s.v);
              return true;
@@ -67,9 +67,9 @@ ChartRun robot_run(bool extrinsic, double h, long steps, const Vec<double, 4>& q
   } else {
     using X = nhi::RobotExtrinsic;
     const X sys;
-    const nhi::DlaStepper<X, nhi::AlphaDiscretization> st(sys, mid, h);
+    nhi::DlaStepper<X, nhi::AlphaDiscretization> st(sys, mid);
     Vec<double, 4> near = q0;
-    r.ok = nhi::integrate_dla(st, X::embed(q0), X::embed_velocity(q0, v0), steps,
+    r.ok = nhi::integrate(st, X::embed(q0), X::embed_velocity(q0, v0), h, steps,
                               [&](const nhi::Sample<6, 2>& s) {
                                 near = X::chart(s.q, near);
                                 r.q.push_back(near);
@@ -101,7 +101,6 @@ json robot_series(const ChartRun& r, double h, const Vec<double, 4>& q0, const V
 }  // namespace
 
 int main(int argc, char** argv) {
-  study::install_signal_handlers();
   const study::Options o = study::parse(argc, argv, "Geometry of the discrete flow: eq. 24, eq. 17, Remark 3.3");
   json out;
   try {
@@ -135,7 +134,7 @@ int main(int argc, char** argv) {
       }
       const std::vector<double> fh(hs.end() - 4, hs.end()), fi(ein.end() - 4, ein.end()), fe(eex.end() - 4, eex.end());
       slots[6] = {{"T", T}, {"h", hs}, {"intrinsic", ein}, {"extrinsic", eex},
-                  {"order_intrinsic", study::loglog_slope(fh, fi)}, {"order_extrinsic", study::loglog_slope(fh, fe)},
+                  {"order_intrinsic", nhi::loglog_slope(fh, fi)}, {"order_extrinsic", nhi::loglog_slope(fh, fe)},
                   {"order_fit", "least squares over the 4 smallest h"}};
     });
     // Remark 3.3: the circle, omega-DLA and g-DLA (eq. 17), h = 0.1.
@@ -149,7 +148,7 @@ int main(int argc, char** argv) {
         std::vector<double> t, dE, radius;
         using St = decltype(stepper);
         constexpr int m = St::m;
-        const bool ok = nhi::integrate_dla(stepper, q0, v0, n, [&](const nhi::Sample<2, m>& s) {
+        const bool ok = nhi::integrate(stepper, q0, v0, hc, n, [&](const nhi::Sample<2, m>& s) {
                           t.push_back(s.t);
                           dE.push_back(nhi::energy(cp, s.q, s.v) - E0);
                           radius.push_back(s.q.norm() - 1.0);
@@ -159,9 +158,9 @@ int main(int argc, char** argv) {
       };
       slots[7] = {{"h", hc},
                   {"omega", series(nhi::DlaStepper<nhi::CircleParticle, nhi::AlphaDiscretization>(
-                                cp, nhi::AlphaDiscretization{0.5}, hc))},
+                                cp, nhi::AlphaDiscretization{0.5}))},
                   {"g", series(nhi::DlaStepper<nhi::CircleHolonomic, nhi::AlphaDiscretization>(
-                            nhi::CircleHolonomic{}, nhi::AlphaDiscretization{0.5}, hc))}};
+                            nhi::CircleHolonomic{}, nhi::AlphaDiscretization{0.5}))}};
     });
     study::Progress progress("geometry", static_cast<long>(tasks.size()));
     study::parallel_for(tasks.size(), o.threads, [&](size_t i) { tasks[i](); }, &progress);

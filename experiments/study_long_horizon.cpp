@@ -1,8 +1,8 @@
 // Study 2: energy and constraints over long horizons.
-// h = 0.2, T = 2e5 (10^6 steps) on both scenes: DLA alpha = 1/2, symmetric
-// DLA (alpha = 0), RK4, the CVODE benchmark; and the other alpha variants
-// (alpha = 0, 1/4, 3/4, 1; symmetric alpha = 1/4), whose energy fate the table
-// states.  Nothing holds every step: the observer keeps, at ~40 log-spaced
+// h = 0.2, T = 2e5 (10^6 steps) on every registered scene, for every library
+// method of nhi::study_methods(): the "main" ones (DLA alpha = 1/2, symmetric
+// DLA alpha = 0, RK4, the reference solution) and the "variant"s (alpha = 0,
+// 1/4, 3/4, 1; symmetric alpha = 1/4), whose energy fate the table states.  Nothing holds every step: the observer keeps, at ~40 log-spaced
 // checkpoints per decade, the instantaneous energy error and constraint value
 // and their running maxima over every step, plus block means of E - E0 over
 // blocks of 1000 steps for the drift rate.
@@ -16,11 +16,6 @@ using study::json;
 constexpr double kH = 0.2;
 constexpr long kSteps = 1000000;
 constexpr long kBlock = 1000;
-
-struct Method {
-  nhi::MethodSpec spec;
-  std::string group;  // "main" or "variant"
-};
 
 template <class S>
 class HorizonObserver {
@@ -135,33 +130,26 @@ std::string fate(const json& run) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const study::Options opt = study::parse(argc, argv, "Energy and constraints over long horizons, both scenes");
-  study::install_signal_handlers();
-  const std::vector<Method> methods = {
-      {{"dla", "alpha", 0.5}, "main"},      {{"dla", "symmetric", 0.0}, "main"},
-      {{"rk4"}, "main"},                    {{"benchmark", "alpha", 0.5, 1e-12}, "main"},
-      {{"dla", "alpha", 0.0}, "variant"},   {{"dla", "alpha", 0.25}, "variant"},
-      {{"dla", "alpha", 0.75}, "variant"},  {{"dla", "alpha", 1.0}, "variant"},
-      {{"dla", "symmetric", 0.25}, "variant"}};
+  const study::Options opt = study::parse(argc, argv, "Energy and constraints over long horizons, every scene");
+  const std::vector<nhi::StudyMethod> methods = study::methods([](const nhi::StudyMethod& m) { return !m.external; });
   json result = {{"study", "long_horizon"},
                  {"config", {{"h", kH}, {"steps", kSteps}, {"T", kH * kSteps}, {"block", kBlock},
                              {"drift_rate", "least-squares slope of block means of E - E0 against t"},
                              {"envelope_growth_exponent", "log-log slope of max_{s<=t} |E - E0| over t in [T/1000, T]"},
                              {"fate", "blows up if a step solve failed or the state became non-finite; dissipates/grows if |mean of E - E0 over the last 10% of blocks| > |E0|/2 (t: when max |E - E0| reached 90% of its final value); drifts if the envelope growth exponent >= 0.1; else bounded"}}}};
-  const std::vector<std::string> scenes = {"particle", "robot"};
+  const std::vector<std::string> scenes = study::scene_names();
   std::vector<json> runs(scenes.size() * methods.size());
   std::vector<json> scene_json;
   for (const auto& name : scenes) scene_json.push_back(study::scene(opt, name));
   study::Progress progress("long horizon", static_cast<long>(runs.size()));
-  // Longest runs (the benchmark) first, so the two workers finish together.
+  // Longest runs (the reference solution) first, so the two workers finish together.
   std::vector<size_t> order(runs.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return (methods[a % methods.size()].spec.kind == "benchmark") > (methods[b % methods.size()].spec.kind == "benchmark");
-  });
+  auto adaptive = [&](size_t i) { return methods[i % methods.size()].spec.kind == "benchmark"; };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return adaptive(a) > adaptive(b); });
   study::parallel_for(runs.size(), opt.threads, [&](size_t oi) {
     const size_t i = order[oi];
-    const Method& m = methods[i % methods.size()];
+    const nhi::StudyMethod& m = methods[i % methods.size()];
     runs[i] = nhi::visit_scene(scene_json[i / methods.size()], [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
       HorizonObserver<S> obs(sys, kSteps);
@@ -169,14 +157,11 @@ int main(int argc, char** argv) {
       const nhi::RunReport rep = nhi::run_method(sys, m.spec, q0, v0, kH, kSteps, obs);
       json j = obs.to_json();
       j["cpu_seconds"] = study::thread_cpu_seconds() - c0;
-      j["label"] = m.spec.label();
+      j["label"] = m.label();
+      j["style"] = m.style();
       j["group"] = m.group;
-      j["status"] = rep.ok ? "ok" : "failed";
-      if (!rep.ok) {
-        const long step = rep.failure_step;
-        j["failure"] = {{"step", step}, {"time", step * kH},
-                        {"reason", rep.reason == "stopped by observer" ? "non-finite energy or constraint" : rep.reason}};
-      }
+      j.update(study::report_json(rep, kH));
+      if (rep.failure == nhi::FailureKind::kObserver) j["failure"]["reason"] = "non-finite energy or constraint";
       j["fate"] = fate(j);
       return j;
     });

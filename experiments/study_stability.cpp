@@ -1,11 +1,12 @@
 // Study 3: where each method fails.
-// h on a geometric grid from 0.01 to 10 (10 per decade), T = 200, both scenes,
-// for the DLA (alpha = 0, 1/4, 1/2, 3/4, 1; symmetric alpha = 0, 1/4) and RK4.
+// h on a geometric grid from 0.01 to 10 (10 per decade), T = 200, every
+// registered scene, for every fixed-step method of nhi::study_methods() (the DLA
+// with alpha = 0, 1/4, 1/2, 3/4, 1 and symmetric alpha = 0, 1/4; RK4).
 // A run fails when a step solve does not converge, the state stops being
 // finite, or |E - E0| exceeds |E0| (an energy error as large as the energy
 // itself).  A run that exceeds the energy threshold goes on to T, so that
 // "stable within the threshold" and "survives at all" are both measured.
-// The CVODE benchmark is adaptive (its h is only the output interval), so it
+// The reference solution is adaptive (its h is only the output interval), so it
 // has no stability limit in h and is not swept.
 #include "study.hpp"
 
@@ -40,7 +41,7 @@ json run_one(const S& sys, const nhi::MethodSpec& spec, const Vec<double, S::n>&
             {"fallback_steps", rep.fallbacks}, {"newton_iterations", rep.newton_iterations}};
   if (rep.ok) j["error_at_T"] = (q_last - qref).cwiseAbs().maxCoeff();
   if (!rep.ok) {
-    const std::string kind = nonfinite || rep.reason.find("non-finite") != std::string::npos ? "non-finite" : "solve";
+    const std::string kind = nonfinite || rep.failure == nhi::FailureKind::kNonFinite ? "non-finite" : "solve";
     j["status"] = "failed";
     j["failure"] = {{"kind", kind}, {"step", rep.failure_step}, {"time", rep.failure_step * h},
                     {"reason", nonfinite ? "non-finite energy" : rep.reason}};
@@ -59,21 +60,17 @@ json run_one(const S& sys, const nhi::MethodSpec& spec, const Vec<double, S::n>&
 }  // namespace
 
 int main(int argc, char** argv) {
-  const study::Options opt = study::parse(argc, argv, "Stability: where each method fails, both scenes");
-  study::install_signal_handlers();
+  const study::Options opt = study::parse(argc, argv, "Stability: where each method fails, every scene");
   std::vector<double> hs;
   for (int i = 0; i <= 30; ++i) hs.push_back(0.01 * std::pow(10.0, i / 10.0));
-  const std::vector<nhi::MethodSpec> methods = {
-      {"dla", "alpha", 0.5},  {"dla", "symmetric", 0.0}, {"dla", "symmetric", 0.25}, {"dla", "alpha", 0.0},
-      {"dla", "alpha", 0.25}, {"dla", "alpha", 0.75},    {"dla", "alpha", 1.0},      {"rk4"}};
+  const std::vector<nhi::StudyMethod> methods = study::methods(study::fixed_step);
   json result = {{"study", "stability"},
                  {"config", {{"T", kT}, {"h", hs},
                              {"failure", "step solve not converged (solve), non-finite state (non-finite), or |E - E0| > |E0| (energy)"},
                              {"largest_stable_h", "largest grid h such that every grid h up to it completed within the energy threshold"},
                              {"largest_surviving_h", "largest grid h such that every grid h up to it reached T with converged solves and a finite state"},
-                             {"benchmark", "not swept: CVODE is adaptive, its h is only the output interval"}}}};
-  const std::vector<std::string> scenes = {"particle", "robot"};
-  for (const auto& name : scenes) {
+                             {"reference", "not swept: the reference solution (CVODE) is adaptive, its h is only the output interval"}}}};
+  for (const auto& name : study::scene_names()) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
@@ -81,7 +78,7 @@ int main(int argc, char** argv) {
       std::vector<json> runs(methods.size() * hs.size());
       study::Progress progress("stability " + name, static_cast<long>(runs.size()));
       study::parallel_for(runs.size(), opt.threads, [&](size_t i) {
-        runs[i] = run_one(sys, methods[i / hs.size()], q0, v0, qref, hs[i % hs.size()]);
+        runs[i] = run_one(sys, methods[i / hs.size()].spec, q0, v0, qref, hs[i % hs.size()]);
       }, &progress);
       json ms = json::array();
       for (size_t m = 0; m < methods.size(); ++m) {
@@ -100,7 +97,7 @@ int main(int argc, char** argv) {
           if (r["survived"] && !dead) survivor = hs[j];
           if (!r["survived"]) dead = true;
         }
-        ms.push_back({{"label", methods[m].label()}, {"runs", rs},
+        ms.push_back({{"label", methods[m].label()}, {"style", methods[m].style()}, {"runs", rs},
                       {"largest_stable_h", largest > 0 ? json(largest) : json(nullptr)},
                       {"largest_surviving_h", survivor > 0 ? json(survivor) : json(nullptr)},
                       {"first_failure", first_failure}});

@@ -1,8 +1,9 @@
 // Study 4: speed against accuracy (work-precision) on both scenes.
 // (a) error max_i |q_i(T) - q_ref,i(T)| at T = 10 against CPU time;
 // (b) max |E - E0| over T = 10^4 against CPU time;
-// for the DLA (alpha = 1/2 and symmetric alpha = 0) and RK4 over h = 0.4 / 2^j,
-// and for adaptive methods over tolerances: CVODE Adams (the benchmark) and the
+// for the "main" fixed-step methods of nhi::study_methods() (DLA alpha = 1/2,
+// symmetric alpha = 0, RK4) over h = 0.4 / 2^j, and for adaptive methods over
+// tolerances: CVODE Adams (the reference solution) and the
 // explicit embedded Runge-Kutta pairs a C++ user would reach for, Boost.Odeint's
 // runge_kutta_fehlberg78 and runge_kutta_dopri5 (controlled, atol = rtol = tol),
 // all on the same index-reduced ODE.  CPU time is per-thread time of a run
@@ -57,8 +58,8 @@ long odeint_run(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::
 }
 
 struct Config {
-  std::string label, kind;  // kind: dla, sym, rk4, cvode, rkf78, dopri5
-  double param;             // h or tolerance
+  nhi::StudyMethod method;
+  double param;  // h (fixed-step methods) or tolerance (adaptive ones)
 };
 
 // Run method `c` to T; obs(t, q, v) sees the trajectory (every step, or every
@@ -70,22 +71,21 @@ bool run(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<d
     obs(s.t, s.q, s.v);
     return true;
   };
-  if (c.kind == "dla" || c.kind == "sym" || c.kind == "rk4") {
-    nhi::MethodSpec m{c.kind == "rk4" ? "rk4" : "dla", c.kind == "sym" ? "symmetric" : "alpha", c.kind == "sym" ? 0.0 : 0.5};
-    return nhi::run_method(sys, m, q0, v0, c.param, std::lround(T / c.param), sample).ok;
-  }
-  if (c.kind == "cvode") {
-    nhi::BenchmarkOptions bo;
-    bo.rtol = bo.atol = c.param;
-    const double out = 0.1;
-    return nhi::integrate_benchmark(sys, out, q0, v0, std::lround(T / out), bo, sample).ok;
-  }
-  if (c.kind == "rkf78") {
-    odeint_run<S, odeint::runge_kutta_fehlberg78<State<S>>>(sys, q0, v0, T, c.param, obs);
+  const nhi::StudyMethod& m = c.method;
+  if (m.external) {
+    if (m.external_label == "rkf78")
+      odeint_run<S, odeint::runge_kutta_fehlberg78<State<S>>>(sys, q0, v0, T, c.param, obs);
+    else
+      odeint_run<S, odeint::runge_kutta_dopri5<State<S>>>(sys, q0, v0, T, c.param, obs);
     return true;
   }
-  odeint_run<S, odeint::runge_kutta_dopri5<State<S>>>(sys, q0, v0, T, c.param, obs);
-  return true;
+  if (m.spec.kind == "benchmark") {  // the reference solution at tolerance param, output every 0.1
+    nhi::MethodSpec spec = m.spec;
+    spec.tolerance = c.param;
+    const double out = 0.1;
+    return nhi::run_method(sys, spec, q0, v0, out, std::lround(T / out), sample).ok;
+  }
+  return nhi::run_method(sys, m.spec, q0, v0, c.param, std::lround(T / c.param), sample).ok;
 }
 
 template <class S>
@@ -106,26 +106,25 @@ double cpu_per_run(const S& sys, const Config& c, const Vec<double, S::n>& q0, c
 }  // namespace
 
 int main(int argc, char** argv) {
-  const study::Options opt = study::parse(argc, argv, "Work-precision: CPU time against accuracy, both scenes");
-  study::install_signal_handlers();
+  const study::Options opt = study::parse(argc, argv, "Work-precision: CPU time against accuracy, every scene");
+  // Fixed-step "main" methods over h; the reference solution and the external
+  // adaptive pairs over tolerances.
+  const auto fixed = study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
+  const auto reference = study::methods([](const nhi::StudyMethod& m) { return m.spec.kind == "benchmark" && !m.external; });
+  const auto external = study::methods([](const nhi::StudyMethod& m) { return m.external; });
   std::vector<Config> configs;
-  for (int j = 0; j <= 9; ++j) {
-    const double h = 0.4 / (1 << j);
-    configs.push_back({"DLA alpha=1/2", "dla", h});
-    configs.push_back({"symmetric DLA alpha=0", "sym", h});
-    configs.push_back({"RK4", "rk4", h});
-  }
-  for (int e = 3; e <= 12; ++e) configs.push_back({"CVODE Adams", "cvode", std::pow(10.0, -e)});
-  for (int e = 3; e <= 13; ++e) {
-    configs.push_back({"odeint rkf78", "rkf78", std::pow(10.0, -e)});
-    configs.push_back({"odeint dopri5", "dopri5", std::pow(10.0, -e)});
-  }
+  for (int j = 0; j <= 9; ++j)
+    for (const auto& m : fixed) configs.push_back({m, 0.4 / (1 << j)});
+  for (int e = 3; e <= 12; ++e)
+    for (const auto& m : reference) configs.push_back({m, std::pow(10.0, -e)});
+  for (int e = 3; e <= 13; ++e)
+    for (const auto& m : external) configs.push_back({m, std::pow(10.0, -e)});
   json result = {{"study", "work_precision"},
                  {"config", {{"T_final_error", kT_final}, {"T_energy", kT_energy},
                              {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
                              {"cpu", "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms"},
                              {"energy_error", "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output point every 0.1 (CVODE)"}}}};
-  for (const std::string name : {"particle", "robot"}) {
+  for (const std::string& name : study::scene_names()) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
@@ -137,7 +136,8 @@ int main(int argc, char** argv) {
       // Per-thread CPU time is what is measured, so --threads 2 on two cores is fair.
       study::parallel_for(configs.size(), opt.threads, [&](size_t i) {
         const Config& c = configs[i];
-        json row = {{"label", c.label}, {"kind", c.kind}, {"param", c.param}};
+        json row = {{"label", c.method.label()}, {"style", c.method.style()},
+                    {"adaptive", c.method.external || c.method.spec.kind == "benchmark"}, {"param", c.param}};
         Vec<double, n> qT = q0;
         const bool ok1 = run(sys, c, q0, v0, kT_final, [&](double, const Vec<double, n>& q, const Vec<double, n>&) { qT = q; });
         double maxE = 0;

@@ -7,6 +7,8 @@ set output out
 m(i, want) = sprintf("< jq -r '.scenes.%s.methods[%d] | select((.family == \"isolation\") == %s) | [.h, .error] | transpose[] | select(.[1] != null) | @tsv' %s", scene, i, want ? "true" : "false", file)
 label(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label) (p = \\(.fitted_order * 100 | round / 100))\"' %s", scene, i, file))
 family(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].family' %s", scene, i, file))
+# Line style of method i: 10 + its fixed style (plots/style.gp).
+sty(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
 N = int(system(sprintf("jq '.scenes.%s.methods | length' %s", scene, file)))
 set logscale xy
 set format y "10^{%L}"
@@ -19,7 +21,7 @@ ref(h, c, p) = c * h**p
 set multiplot layout 1,2 title sprintf("Convergence at T = 10 (%s), against CVODE at tol 1e-13", scene)
 set title "DLA (alpha, symmetric) and RK4"
 set style data linespoints
-plot for [i=0:N-1] m(i, 0) u 1:2 w lp pt (i % 7 + 4) ps 0.8 t (family(i) eq "isolation" ? "" : label(i)), \
+plot for [i=0:N-1] m(i, 0) u 1:2 w lp ls sty(i) ps 0.8 t (family(i) eq "isolation" ? "" : label(i)), \
      ref(x, 1, 1) w l dt 2 lc rgb "#888888" t "h^1", ref(x, 0.5, 2) w l dt 3 lc rgb "#888888" t "h^2", \
      ref(x, 0.05, 4) w l dt 4 lc rgb "#888888" t "h^4"
 set title "what limits alpha != 1/2: L_d and omega_d of different alpha, and the start p_0"

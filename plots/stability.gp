@@ -4,6 +4,8 @@
 load "plots/style.gp"
 set terminal pngcairo size 1500,560 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
+# Line style of method i: 10 + its fixed style (plots/style.gp).
+sty(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
 N = int(system(sprintf("jq '.scenes.%s.methods | length' %s", scene, file)))
 label(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].label' %s", scene, i, file))
 # h, max |E - E0| for runs of method i with the given status filter
@@ -17,11 +19,11 @@ set ylabel "max |E - E_0| over the run"
 set yrange [1e-10:1e30]
 set key top left font ",8" spacing 0.9
 set title "error as h grows (filled: ok; open circle: energy threshold; x: solve failed; triangle: non-finite)"
-plot for [i=0:N-1] runs(i, ".status == \"ok\"") u 1:2 w lp pt 7 ps 0.6 lc i+1 notitle, \
-     for [i=0:N-1] 1/0 w lp pt 7 ps 0.6 lc i+1 t label(i), \
-     for [i=0:N-1] runs(i, ".failure.kind == \"energy\"") u 1:2 w p pt 6 ps 0.9 lc i+1 notitle, \
-     for [i=0:N-1] runs(i, ".failure.kind == \"solve\"") u 1:2 w p pt 2 ps 1.4 lc i+1 notitle, \
-     for [i=0:N-1] runs(i, ".failure.kind == \"non-finite\"") u 1:2 w p pt 8 ps 1.4 lc i+1 notitle
+plot for [i=0:N-1] runs(i, ".status == \"ok\"") u 1:2 w lp ls sty(i) pt 7 ps 0.6 notitle, \
+     for [i=0:N-1] 1/0 w lp ls sty(i) ps 0.6 t label(i), \
+     for [i=0:N-1] runs(i, ".failure.kind == \"energy\"") u 1:2 w p ls sty(i) pt 6 ps 0.9 notitle, \
+     for [i=0:N-1] runs(i, ".failure.kind == \"solve\"") u 1:2 w p ls sty(i) pt 2 ps 1.4 notitle, \
+     for [i=0:N-1] runs(i, ".failure.kind == \"non-finite\"") u 1:2 w p ls sty(i) pt 8 ps 1.4 notitle
 unset logscale y
 set logscale y
 set format y "%g"

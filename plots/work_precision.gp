@@ -5,8 +5,11 @@ load "plots/style.gp"
 set terminal pngcairo size 1400,600 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 set datafile separator "\t"
-labels = "DLA alpha=1/2|symmetric DLA alpha=0|RK4|CVODE Adams|odeint rkf78|odeint dopri5"
-lab(i) = system(sprintf("echo '%s' | cut -d'|' -f%d", labels, i))
+# The methods of this scene in their fixed order (style), from the JSON.
+methods = sprintf("jq -r '[.scenes.%s.runs[] | {label: .label, style: .style}] | unique_by(.style) | .[]' %s", scene, file)
+N = int(system(methods . " | jq -s length"))
+lab(i) = system(methods . sprintf(" | jq -s -r '.[%d].label'", i - 1))
+sty(i) = 10 + int(system(methods . sprintf(" | jq -s -r '.[%d].style'", i - 1)))
 pts(i, err, cpu) = sprintf("< jq -r '.scenes.%s.runs[] | select(.label == \"%s\" and .status == \"ok\") | [.%s, .%s] | @tsv' %s", scene, lab(i), cpu, err, file)
 set logscale xy
 set format x "10^{%L}"
@@ -17,8 +20,8 @@ set multiplot layout 1,2 title sprintf("Work-precision (%s): fixed-step methods 
 set title "error in q at T = 10 against CPU time"
 set xlabel "CPU seconds per run"
 set ylabel "max_i |q_i(T) - q_{ref,i}(T)|"
-plot for [i=1:6] pts(i, "final_error", "cpu_final") u 1:2 pt (i + 3) ps 0.9 lc i t lab(i)
+plot for [i=1:N] pts(i, "final_error", "cpu_final") u 1:2 ls sty(i) ps 0.9 t lab(i)
 set title "largest |E - E_0| over T = 10^4 against CPU time"
 set ylabel "max |E - E_0|"
-plot for [i=1:6] pts(i, "max_energy_error", "cpu_energy") u 1:2 pt (i + 3) ps 0.9 lc i t lab(i)
+plot for [i=1:N] pts(i, "max_energy_error", "cpu_energy") u 1:2 ls sty(i) ps 0.9 t lab(i)
 unset multiplot

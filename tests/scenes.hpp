@@ -8,36 +8,46 @@
 
 #include "nhi/fit.hpp"
 #include "nhi/integrate.hpp"
-#include "nhi/systems/particle.hpp"
-#include "nhi/systems/robot.hpp"
+#include "nhi/methods.hpp"
+#include "nhi/systems/registry.hpp"
 
 namespace nhi::test {
 
-// Every scene the library has; typed tests run on each.
-using Systems = ::testing::Types<Particle, Robot>;
+// Every registered scene (systems/registry.hpp); typed tests run on each, or on
+// those that declare the capability a suite needs.
+using Systems = nhi::Systems::apply<::testing::Types>;
+using ReversibleSystems = filter_t<is_reversible, nhi::Systems>::apply<::testing::Types>;
+using ChaplyginSystems = filter_t<has_chaplygin_split, nhi::Systems>::apply<::testing::Types>;
+using PaperSystems = filter_t<is_paper_scene, nhi::Systems>::apply<::testing::Types>;
+using MomentumEquationSystems = filter_t<has_momentum_equation, nhi::Systems>::apply<::testing::Types>;
 
 template <class S>
 S make_system() {
   return S{};
 }
 
-// The initial state of the scene files (experiments/scenes/*.json).
+// The system's default initial state (the numbers of experiments/scenes/NAME.json;
+// test_scene checks that they agree).
 template <class S>
 void scene_state(Vec<double, S::n>* q, Vec<double, S::n>* v) {
-  if constexpr (std::is_same_v<S, Particle>) {
-    *q << 1.0, 0.5, 0.0;
-    *v << 0.5, 1.0, 0.25;
-  } else {
-    *q << 0.0, 0.0, 0.0, 0.0;
-    *v << 1.0, 0.0, 1.0, 1.0;
-  }
+  *q = S::default_q0();
+  *v = S::default_v0();
 }
 
-// A random configuration and a random velocity satisfying omega(q) v = 0.
+// The system with every parameter of its table drawn from [0.5, 2] (so that no
+// coefficient is 1 and swapped or dropped coefficients show).
 template <class S>
-void random_state(std::mt19937& rng, Vec<double, S::n>* q, Vec<double, S::n>* v) {
+S randomized_system(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.5, 2.0);
+  S sys;
+  for (const auto& p : S::parameters()) sys.*(p.member) = u(rng);
+  return sys;
+}
+
+// A random configuration and a random velocity satisfying omega(q) v = 0 (of sys).
+template <class S>
+void random_state(std::mt19937& rng, Vec<double, S::n>* q, Vec<double, S::n>* v, const S& sys = make_system<S>()) {
   std::uniform_real_distribution<double> u(-1.5, 1.5);
-  const S sys = make_system<S>();
   for (int i = 0; i < S::n; ++i) (*q)[i] = u(rng);
   Vec<double, S::n> w;
   for (int i = 0; i < S::n; ++i) w[i] = u(rng);

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 
 #include <filesystem>
@@ -189,6 +190,17 @@ TEST_F(Cli, HostileScenesFailWithOneLineAndTouchNoFile) {
   // No temporary files left behind.
   for (const auto& e : fs::directory_iterator(dir_))
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+}
+
+// A run whose recorded points cannot fit in memory is refused before it starts
+// (issue 10, item 8): exit 2, one line naming output_every, nothing written.
+TEST_F(Cli, RunTooLargeForMemoryIsRefusedBeforeItStarts) {
+  const std::string out = path("big.json");
+  const Result r = run("run " + scene() + " --set method=rk4 --set h=0.01 --set steps=100000000 -o " + out);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("scene key 'output_every'"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST_F(Cli, BadCommandLinesFailWithOneLine) {

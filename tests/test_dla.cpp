@@ -21,7 +21,7 @@ std::pair<double, double> worst_residuals(const D& disc, double h, long steps) {
   std::mt19937 rng(11);
   Vec<double, n> q, v;
   random_state<S>(rng, &q, &v);
-  DlaStepper<S, D> st(sys, disc, h);
+  DlaMap<S, D> st(sys, disc, h);
   Vec<double, n> p = momentum(sys, q, v), guess = q + h * v, q_next = q, p_next = p;
   Vec<double, m> lambda = Vec<double, m>::Zero();
   double worst_r = 0, worst_c = 0;
@@ -71,10 +71,10 @@ TEST(DlaVariational, UnconstrainedDlaIsTheVariationalIntegratorInClosedForm) {
     const double c = 0.5 * (2 / h - h * k * (a * a + (1 - a) * (1 - a))) / (1 / h + h * k * a * (1 - a));
     ASSERT_LT(std::abs(c), 1.0);
     const double th = std::acos(c);
-    DlaStepper<Oscillator, AlphaDiscretization> st(osc, AlphaDiscretization{a}, h);
+    DlaStepper<Oscillator, AlphaDiscretization> st(osc, AlphaDiscretization{a});
     Vec<double, 1> q0(0.7), v0(-0.4);
     std::vector<double> qs;
-    const RunReport rep = integrate_dla(st, q0, v0, 2000, [&](const Sample<1, 0>& s) {
+    const RunReport rep = integrate(st, q0, v0, h, 2000, [&](const Sample<1, 0>& s) {
       qs.push_back(s.q[0]);
       return true;
     });
@@ -95,7 +95,7 @@ TEST(DlaTraits, MethodsKnowTheirOrder) {
   EXPECT_TRUE(AlphaDiscretization{0.5}.symmetric());
   EXPECT_FALSE(AlphaDiscretization{0.25}.symmetric());
   EXPECT_EQ(SymmetricDiscretization{0.0}.order(), 2);
-  EXPECT_EQ(Rk4Stepper<Particle>::order(), 4);
+  EXPECT_EQ(Rk4Stepper<Particle>(Particle{}).traits().order, 4);
 }
 
 }  // namespace

@@ -102,11 +102,11 @@ TYPED_TEST(Theorem43, LinearEmbeddingGivesTheSameIntegrator) {
   const double h = 0.1;
   for (double alpha : {0.5, 0.25, 1.0}) {
     const AlphaDiscretization disc{alpha};
-    const DlaStepper<S, AlphaDiscretization> in(sys, disc, h);
-    const DlaStepper<LinearlyEmbedded<S>, AlphaDiscretization> out(ext, disc, h);
+    DlaStepper<S, AlphaDiscretization> in(sys, disc);
+    const DlaMap<LinearlyEmbedded<S>, AlphaDiscretization> out(ext, disc, h);
     std::vector<Vec<double, n>> qs, ps;
     std::vector<Vec<double, m>> mus;
-    ASSERT_TRUE(integrate_dla(in, q0, v0, 300, [&](const Sample<n, m>& s) {
+    ASSERT_TRUE(integrate(in, q0, v0, h, 300, [&](const Sample<n, m>& s) {
                   qs.push_back(s.q);
                   ps.push_back(s.p);
                   mus.push_back(s.lambda);
@@ -147,16 +147,16 @@ TYPED_TEST(Theorem43, LinearEmbeddingRunStaysOnTheIntrinsicRun) {
   Vec<double, n> q0, v0;
   scene_state<S>(&q0, &v0);
   const double h = 0.1;
-  const DlaStepper<S, AlphaDiscretization> in(sys, AlphaDiscretization{0.5}, h);
-  const DlaStepper<LinearlyEmbedded<S>, AlphaDiscretization> out(ext, AlphaDiscretization{0.5}, h);
+  DlaStepper<S, AlphaDiscretization> in(sys, AlphaDiscretization{0.5});
+  DlaStepper<LinearlyEmbedded<S>, AlphaDiscretization> out(ext, AlphaDiscretization{0.5});
   std::vector<Vec<double, n>> qs;
-  ASSERT_TRUE(integrate_dla(in, q0, v0, 1000, [&](const Sample<n, m>& s) {
+  ASSERT_TRUE(integrate(in, q0, v0, h, 1000, [&](const Sample<n, m>& s) {
                 qs.push_back(s.q);
                 return true;
               }).ok);
   double worst = 0, worst_g = 0;
   long k = 0;
-  ASSERT_TRUE(integrate_dla(out, ext.embed(q0), ext.A() * v0, 1000, [&](const Sample<n + 1, m>& s) {
+  ASSERT_TRUE(integrate(out, ext.embed(q0), ext.A() * v0, h, 1000, [&](const Sample<n + 1, m>& s) {
                 worst = std::max(worst, (ext.chart_of(s.q, true) - qs[k]).cwiseAbs().maxCoeff() /
                                             (1.0 + qs[k].cwiseAbs().maxCoeff()));
                 worst_g = std::max(worst_g, std::abs(ext.template g<double>(s.q)[0]));
@@ -180,8 +180,7 @@ Trajectory intrinsic_run(double h, long steps) {
   Vec<double, 4> q0, v0;
   scene_state<Robot>(&q0, &v0);
   Trajectory tr;
-  const DlaStepper<Robot, AlphaDiscretization> st(Robot{}, AlphaDiscretization{0.5}, h);
-  EXPECT_TRUE(integrate_dla(st, q0, v0, steps, [&](const Sample<4, 2>& s) {
+  EXPECT_TRUE(integrate(DlaStepper<Robot, AlphaDiscretization>(Robot{}, AlphaDiscretization{0.5}), q0, v0, h, steps, [&](const Sample<4, 2>& s) {
                 tr.q.push_back(s.q);
                 tr.v.push_back(s.v);
                 return true;
@@ -196,9 +195,9 @@ Trajectory extrinsic_run(double h, long steps) {
   scene_state<Robot>(&q0, &v0);
   Trajectory tr;
   const RobotExtrinsic sys;
-  const DlaStepper<RobotExtrinsic, AlphaDiscretization> st(sys, AlphaDiscretization{0.5}, h);
+  DlaStepper<RobotExtrinsic, AlphaDiscretization> st(sys, AlphaDiscretization{0.5});
   Vec<double, 4> near = q0;
-  EXPECT_TRUE(integrate_dla(st, RobotExtrinsic::embed(q0), RobotExtrinsic::embed_velocity(q0, v0), steps,
+  EXPECT_TRUE(integrate(st, RobotExtrinsic::embed(q0), RobotExtrinsic::embed_velocity(q0, v0), h, steps,
                             [&](const Sample<6, 2>& s) {
                               const Vec<double, 4> q = RobotExtrinsic::chart(s.q, near);
                               near = q;

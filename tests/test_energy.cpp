@@ -8,7 +8,7 @@ namespace {
 
 template <class S>
 class EnergyTest : public ::testing::Test {};
-TYPED_TEST_SUITE(EnergyTest, Systems);
+TYPED_TEST_SUITE(EnergyTest, PaperSystems);
 
 // max |E - E0| over each sixteenth of a run of `steps` steps.
 template <class S, class Integrate>
@@ -31,12 +31,11 @@ TYPED_TEST(EnergyTest, DlaEnergyBoundedWhileRk4Drifts) {
   const S sys = make_system<S>();
   const double h = 0.2;
   const long steps = 50000;  // T = 10^4
-  DlaStepper<S, AlphaDiscretization> dla(sys, AlphaDiscretization{0.5}, h);
   const auto d = bin_maxima(sys, steps, [&](auto q0, auto v0, long n, auto&& obs) {
-    return integrate_dla(dla, q0, v0, n, obs);
+    return integrate(DlaStepper<S, AlphaDiscretization>(sys, AlphaDiscretization{0.5}), q0, v0, h, n, obs);
   });
   const auto r = bin_maxima(sys, steps, [&](auto q0, auto v0, long n, auto&& obs) {
-    return integrate_rk4(Rk4Stepper<S>(sys, h), q0, v0, n, obs);
+    return integrate(Rk4Stepper<S>(sys), q0, v0, h, n, obs);
   });
   // DLA: the error in the last sixteenth is no larger than in the first (bounded oscillation).
   EXPECT_LE(d[15], 1.1 * d[0]) << d[0] << " " << d[15];

@@ -14,8 +14,7 @@ template <class S, class D>
 void dla_run(const S& sys, const D& disc, double h, const Vec<double, S::n>& q0,
              const Vec<double, S::n>& v0, long steps, std::vector<Vec<double, S::n>>* qs,
              std::vector<Vec<double, S::n>>* ps) {
-  const DlaStepper<S, D> st(sys, disc, h);
-  const RunReport rep = integrate_dla(st, q0, v0, steps, [&](const Sample<S::n, S::m>& s) {
+  const RunReport rep = integrate(DlaStepper<S, D>(sys, disc), q0, v0, h, steps, [&](const Sample<S::n, S::m>& s) {
     qs->push_back(s.q);
     ps->push_back(s.p);
     return true;
@@ -65,9 +64,9 @@ TEST(Theorem53, ParticleContinuousMomentumEquationAlongTheBenchmark) {
   const Vec<double, 3> q0(1.0, 0.5, 0.0), v0(0.5, 1.0, 0.25);
   const double dt = 1e-3;
   std::vector<double> J, rhs;
-  BenchmarkOptions bo;
+  ReferenceOptions bo;
   bo.rtol = bo.atol = 1e-13;
-  integrate_benchmark(sys, dt, q0, v0, 20000, bo, [&](const Sample<3, 1>& s) {
+  integrate(ReferenceStepper<Particle>(sys, bo), q0, v0, dt, 20000, [&](const Sample<3, 1>& s) {
     J.push_back(s.v[0] + s.q[1] * s.v[2]);
     rhs.push_back(s.v[2] * s.v[1]);
     return true;
@@ -196,7 +195,7 @@ struct FormWalk {
 template <class S, class D>
 FormWalk walk_form(const S& sys, const D& disc, double h, Vec<double, S::n> q, Vec<double, S::n> v, int steps) {
   constexpr int n = S::n, m = S::m;
-  const DlaStepper<S, D> st(sys, disc, h);
+  const DlaMap<S, D> st(sys, disc, h);
   Vec<double, n> p = momentum(sys, q, v), q1, p1, guess = q + h * v;
   Vec<double, m> lambda = Vec<double, m>::Zero();
   const Eigen::MatrixXd Jm = canonical_form(n);
@@ -294,7 +293,7 @@ double restricted_defect(double eps) {
   constexpr int n = 3;
   const double h = 0.2;
   const AlphaDiscretization disc{0.5};
-  const DlaStepper<EpsParticle, AlphaDiscretization> st(sys, disc, h);
+  const DlaMap<EpsParticle, AlphaDiscretization> st(sys, disc, h);
   Vec<double, n> q(1.0, 0.5, 0.0), v(0.5, 1.0, 0.25 * eps), q1, p1, guess = q + h * v;
   Vec<double, n> p = momentum(sys, q, v);
   Vec<double, 1> lambda = Vec<double, 1>::Zero();
@@ -384,7 +383,7 @@ TEST(Corollary54, HorizontalSymmetryMomentumIsConservedExactly) {
   }
   // Continuous: ud + eps yd is constant along the benchmark.
   double worst = 0;
-  integrate_benchmark(sys, 0.1, q0, v0, 500, BenchmarkOptions{}, [&](const Sample<4, 1>& s) {
+  integrate(ReferenceStepper<decltype(sys)>(sys), q0, v0, 0.1, 500, [&](const Sample<4, 1>& s) {
     worst = std::max(worst, std::abs(s.v[3] + sys.eps * s.v[1] - (v0[3] + sys.eps * v0[1])));
     return true;
   });
@@ -452,7 +451,7 @@ TEST(Remark33, HolonomicFormulationGivesTheSameStep) {
   // One eq.-17 step from each state of the omega run.  The omega step keeps
   // |q_{k+1}| = |q_k|, the g step |q_{k+1}| = 1: they differ by the radius's
   // round-off drift ||q_k| - 1| (3e-12 here) and by the solver's round-off.
-  const DlaStepper<CircleHolonomic, AlphaDiscretization> st(CircleHolonomic{}, AlphaDiscretization{0.5}, h);
+  const DlaMap<CircleHolonomic, AlphaDiscretization> st(CircleHolonomic{}, AlphaDiscretization{0.5}, h);
   double worst = 0, radius = 0;
   for (size_t k = 0; k + 1 < qa.size(); ++k) {
     Vec<double, 2> q1, p1;

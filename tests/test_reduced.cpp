@@ -11,7 +11,7 @@ namespace {
 
 template <class S>
 class ReducedTest : public ::testing::Test {};
-TYPED_TEST_SUITE(ReducedTest, Systems);
+TYPED_TEST_SUITE(ReducedTest, ChaplyginSystems);
 
 TYPED_TEST(ReducedTest, ConstraintsHaveTheChaplyginForm) {
   using S = TypeParam;
@@ -38,8 +38,7 @@ void check_equivalence(const D& disc, double h, long steps) {
   Vec<double, n> q0, v0;
   scene_state<S>(&q0, &v0);
   std::vector<Vec<double, n>> qs, ps;
-  DlaStepper<S, D> dla(sys, disc, h);
-  const RunReport rep = integrate_dla(dla, q0, v0, steps, [&](const Sample<n, m>& s) {
+  const RunReport rep = integrate(DlaStepper<S, D>(sys, disc), q0, v0, h, steps, [&](const Sample<n, m>& s) {
     qs.push_back(s.q);
     ps.push_back(s.p);
     return true;

@@ -19,7 +19,7 @@ TEST(Robot, ReducedSolutionMatchesTheBenchmark) {
     }
     const double h = 0.5;
     double worst = 0;
-    integrate_benchmark(sys, h, q0, v0, 80, BenchmarkOptions{1e-12, 1e-12},
+    integrate(ReferenceStepper<Robot>(sys, ReferenceOptions{1e-12, 1e-12}), q0, v0, h, 80,
                         [&](const Sample<4, 2>& s) {
                           Vec<double, 4> q, v;
                           sys.reduced_flow(q0, v0, s.t, 2000, &q, &v);

@@ -28,6 +28,21 @@ struct Bad {
   std::function<void(json&)> edit;
 };
 
+// The memory refusal (issue 10, item 8) depends on the stride, not on the steps alone.
+TEST(Scene, RefusesOnlyRunsWhosePointsCannotFit) {
+  json s = good();
+  s["method"] = "rk4";
+  s["steps"] = 100000000;
+  try {
+    validate_scene(s);
+    ADD_FAILURE() << "10^8 recorded points accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("'output_every'"), std::string::npos) << e.what();
+  }
+  s["output_every"] = 100000;
+  EXPECT_NO_THROW(validate_scene(s));
+}
+
 TEST(Scene, RejectsBadInputNamingTheKey) {
   const std::vector<Bad> cases = {
       {"unknown system", "system", [](json& s) { s["system"] = "pendulum"; }},

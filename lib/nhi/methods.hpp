@@ -136,15 +136,15 @@ struct StudyMethod {
 
 inline const std::vector<StudyMethod>& study_methods() {
   static const std::vector<StudyMethod> list = {
-      {{"dla", "alpha", 0.5}, "main"},
-      {{"dla", "symmetric", 0.0}, "main"},
-      {{"rk4"}, "main"},
-      {{"benchmark", "alpha", 0.5, 1e-12}, "main"},
-      {{"dla", "alpha", 0.0}, "variant"},
-      {{"dla", "alpha", 0.25}, "variant"},
-      {{"dla", "alpha", 0.75}, "variant"},
-      {{"dla", "alpha", 1.0}, "variant"},
-      {{"dla", "symmetric", 0.25}, "variant"},
+      {{"dla", "alpha", 0.5}, "main", false, ""},
+      {{"dla", "symmetric", 0.0}, "main", false, ""},
+      {{"rk4"}, "main", false, ""},
+      {{"benchmark", "alpha", 0.5, 1e-12}, "main", false, ""},
+      {{"dla", "alpha", 0.0}, "variant", false, ""},
+      {{"dla", "alpha", 0.25}, "variant", false, ""},
+      {{"dla", "alpha", 0.75}, "variant", false, ""},
+      {{"dla", "alpha", 1.0}, "variant", false, ""},
+      {{"dla", "symmetric", 0.25}, "variant", false, ""},
       {{}, "main", true, "rkf78"},
       {{}, "main", true, "dopri5"},
   };

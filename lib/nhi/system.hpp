@@ -20,6 +20,7 @@
 //   shape, group                              // a Chaplygin split (reduced.hpp)
 //   nonholonomic_momentum, momentum_equation_rhs   // a symmetry for eq. (24)
 //   reduced_flow                               // an independent exact reduced description
+//   paper_section                              // one of the paper's scenes (section 6.x)
 // The pair (l, g) adds l holonomic constraints g(q) = 0: the Constrained Coordinate
 // Formulation (paper eq. 17), where Q is a submanifold g = 0 of a vector space V
 // and the configuration is a point of V (e.g. an angle as a unit vector).
@@ -55,6 +56,12 @@ template <class S, class = void>
 struct is_reversible : std::false_type {};
 template <class S>
 struct is_reversible<S, std::enable_if_t<S::reversible>> : std::true_type {};
+
+// One of the paper's own scenes (section 6), where its claims are asserted as stated.
+template <class S, class = void>
+struct is_paper_scene : std::false_type {};
+template <class S>
+struct is_paper_scene<S, std::void_t<decltype(S::paper_section)>> : std::true_type {};
 
 template <class S, class = void>
 struct has_chaplygin_split : std::false_type {};

@@ -96,8 +96,8 @@ double available_bytes() {
 // A run keeps its recorded points until it writes them: per point the numbers
 // in the Recorder's vectors (8 bytes), as JSON values (16 bytes plus the
 // arrays around them) and as text (up to 25 bytes), with a per-point overhead
-// for the row arrays.  Measured: particle DLA, 10^6 points, peak RSS 1.08 GB
-// (1080 bytes per point); this estimate gives 1320.
+// for the row arrays.  Measured: particle DLA, 10^6 points, peak RSS 1.12 GB
+// (1120 bytes per point, a 282 MB result file); this estimate gives 1320.
 double estimated_bytes_per_point(int n, int m, bool has_p) {
   const int numbers = 1 + n + n + 1 + m + (has_p ? n + m + m : 0);
   const int rows = 4 + (has_p ? 3 : 0);

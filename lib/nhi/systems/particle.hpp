@@ -33,6 +33,7 @@ struct Particle {
 
   // L and omega are invariant under (q, v) -> (q, -v): the standard reversing symmetry.
   static constexpr bool reversible = true;
+  static constexpr const char* paper_section = "6.1";
 
   double kx = 1.0;  // potential V = kx x^2 + ky y^2
   double ky = 1.0;

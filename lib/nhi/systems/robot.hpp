@@ -43,6 +43,7 @@ struct Robot {
 
   // L and omega are invariant under (q, v) -> (q, -v): the standard reversing symmetry.
   static constexpr bool reversible = true;
+  static constexpr const char* paper_section = "6.2";
 
   double mass = 1.0;  // m
   double I = 1.0;

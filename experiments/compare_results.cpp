@@ -1,0 +1,211 @@
+// compare_results: checks that the JSON files an experiment run writes into results/
+// agree with those of a previous run to round-off. Used while refactoring: run the
+// studies into a fresh directory, then
+//
+//   compare_results OLD_DIR NEW_DIR [--tol 1e-9] [--ignore-key NAME]... [--per-key]
+//
+// Every *.json file of OLD_DIR (sorted by name) is compared with NEW_DIR/<same name>;
+// both trees are walked in parallel. Numbers are compared by relative difference
+// |a-b| / max(|a|, |b|, 1e-300) (integers and floats alike); strings must be equal, but a
+// string mismatch is only reported as a "text difference" (method labels may be renamed
+// on purpose). Missing keys, arrays of different length, type mismatches (null vs
+// number included) and changed booleans are "structural" differences. Timing, provenance
+// and machine-dependent keys are skipped (see the constants below).
+//
+// Exit status: 0 if no file is missing, there are no structural differences and every
+// max rel diff <= tol; 1 otherwise; 2 on a usage error or unreadable JSON.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// ---- What is not compared ------------------------------------------------------------
+// Object keys skipped wherever they occur (timing, provenance, machine dependent).
+const std::set<std::string> SKIP_KEYS = {
+    "meta",        "wall_seconds", "cpu_seconds", "cpu_ns",   "real_ns",
+    "cpu_final",   "cpu_energy",   "peak_rss_kb", "time_utc",
+};
+// Object keys skipped only inside one file: {file name, key}.
+const std::set<std::pair<std::string, std::string>> SKIP_KEYS_IN_FILE = {
+    {"step_costs.json", "iterations"},  // Google Benchmark iteration counts
+};
+// Files not compared at all (Google Benchmark timings only).
+const std::set<std::string> SKIP_FILES = {"step_costs.json"};
+// Paths printed per kind of difference.
+constexpr int MAX_LISTED = 3;
+
+struct FileReport {
+  long numbers = 0;
+  double max_rel = 0.0;
+  std::string max_path;
+  double max_old = 0.0, max_new = 0.0;
+  long structural = 0, text = 0;
+  std::vector<std::string> structural_list, text_list;
+  std::map<std::string, std::pair<double, long>> per_key;  // leaf key -> (max rel, count)
+};
+
+struct Comparer {
+  std::string file;
+  std::set<std::string> extra_skip;  // from --ignore-key
+  FileReport r;
+
+  bool skipped(const std::string& key) const {
+    return SKIP_KEYS.count(key) || extra_skip.count(key) || SKIP_KEYS_IN_FILE.count({file, key});
+  }
+  void structural(const std::string& path, const std::string& what) {
+    if (r.structural++ < MAX_LISTED) r.structural_list.push_back((path.empty() ? "(root)" : path) + ": " + what);
+  }
+  static std::string kind(const json& v) {
+    return v.is_number() ? "number" : v.type_name();
+  }
+
+  // `leaf` is the name of the nearest enclosing object key (used by --per-key).
+  void walk(const json& a, const json& b, std::string& path, const std::string& leaf) {
+    if (a.is_number() && b.is_number()) {
+      const double x = a.get<double>(), y = b.get<double>();
+      double rel = 0.0;
+      if (x != y) rel = std::fabs(x - y) / std::max({std::fabs(x), std::fabs(y), 1e-300});
+      ++r.numbers;
+      auto& pk = r.per_key[leaf.empty() ? "(root)" : leaf];
+      pk.first = std::max(pk.first, rel);
+      ++pk.second;
+      if (rel > r.max_rel) { r.max_rel = rel; r.max_path = path; r.max_old = x; r.max_new = y; }
+    } else if (kind(a) != kind(b)) {
+      structural(path, "type " + kind(a) + " -> " + kind(b));
+    } else if (a.is_object()) {
+      const size_t len = path.size();
+      for (auto it = a.begin(); it != a.end(); ++it) {
+        if (skipped(it.key())) continue;
+        path += (len ? "." : "") + it.key();
+        if (!b.contains(it.key())) structural(path, "missing in new");
+        else walk(it.value(), b.at(it.key()), path, it.key());
+        path.resize(len);
+      }
+      for (auto it = b.begin(); it != b.end(); ++it)
+        if (!skipped(it.key()) && !a.contains(it.key()))
+          structural(path + (len ? "." : "") + it.key(), "missing in old");
+    } else if (a.is_array()) {
+      if (a.size() != b.size())
+        structural(path, "array length " + std::to_string(a.size()) + " -> " + std::to_string(b.size()));
+      const size_t len = path.size(), n = std::min(a.size(), b.size());
+      for (size_t i = 0; i < n; ++i) {
+        path += "[" + std::to_string(i) + "]";
+        walk(a[i], b[i], path, leaf);
+        path.resize(len);
+      }
+    } else if (a.is_string()) {
+      if (a != b && r.text++ < MAX_LISTED)
+        r.text_list.push_back(path + ": " + a.dump() + " -> " + b.dump());
+    } else if (a != b) {  // booleans (null == null)
+      structural(path, "value " + a.dump() + " -> " + b.dump());
+    }
+  }
+};
+
+static bool load(const fs::path& p, json& out) {
+  std::ifstream in(p);
+  if (!in) { std::printf("%s: cannot open\n", p.string().c_str()); return false; }
+  try {
+    out = json::parse(in);
+  } catch (const std::exception& e) {
+    std::printf("%s: unreadable JSON: %s\n", p.string().c_str(), e.what());
+    return false;
+  }
+  return true;
+}
+
+static std::vector<std::string> json_files(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_regular_file() && e.path().extension() == ".json") names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+static int usage(const char* msg) {
+  std::fprintf(stderr, "%s\nusage: compare_results OLD_DIR NEW_DIR [--tol 1e-9] [--ignore-key NAME]... [--per-key]\n", msg);
+  return 2;
+}
+
+int main(int argc, char** argv) {
+  std::vector<std::string> dirs;
+  double tol = 1e-9;
+  bool per_key = false;
+  std::set<std::string> ignore;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--tol" || arg == "--ignore-key") {
+      if (i + 1 >= argc) return usage(("missing value after " + arg).c_str());
+      const std::string val = argv[++i];
+      if (arg == "--ignore-key") { ignore.insert(val); continue; }
+      char* end = nullptr;
+      tol = std::strtod(val.c_str(), &end);
+      if (val.empty() || *end != '\0' || !(tol >= 0)) return usage(("bad --tol value: " + val).c_str());
+    } else if (arg == "--per-key") {
+      per_key = true;
+    } else if (arg.rfind("--", 0) == 0) {
+      return usage(("unknown option: " + arg).c_str());
+    } else {
+      dirs.push_back(arg);
+    }
+  }
+  if (dirs.size() != 2) return usage("need exactly two directories");
+  const fs::path old_dir = dirs[0], new_dir = dirs[1];
+  for (const auto& d : {old_dir, new_dir})
+    if (!fs::is_directory(d)) return usage(("not a directory: " + d.string()).c_str());
+
+  const auto old_files = json_files(old_dir), new_files = json_files(new_dir);
+  bool fail = false, unreadable = false;
+  double overall = 0.0;
+  std::string overall_where = "-";
+  long files_compared = 0, missing = 0;
+
+  for (const auto& f : old_files) {
+    if (SKIP_FILES.count(f)) { std::printf("%s: skipped (timings)\n", f.c_str()); continue; }
+    if (!fs::exists(new_dir / f)) { std::printf("%s: missing in %s\n", f.c_str(), new_dir.c_str()); ++missing; fail = true; continue; }
+    json a, b;
+    if (!load(old_dir / f, a) | !load(new_dir / f, b)) { unreadable = true; continue; }
+    Comparer c{f, ignore, {}};
+    std::string path;
+    c.walk(a, b, path, "");
+    const FileReport& r = c.r;
+    ++files_compared;
+    if (r.max_rel == 0.0 && r.structural == 0 && r.text == 0) {
+      std::printf("%s: %ld numbers, identical\n", f.c_str(), r.numbers);
+    } else {
+      std::printf("%s: %ld numbers, max rel diff %.3g", f.c_str(), r.numbers, r.max_rel);
+      if (r.max_rel > 0) std::printf(" at %s (old %.17g, new %.17g)", r.max_path.c_str(), r.max_old, r.max_new);
+      std::printf("; %ld structural, %ld text differences%s\n", r.structural, r.text, r.max_rel > tol ? "  [> tol]" : "");
+      for (const auto& s : r.structural_list) std::printf("    structural: %s\n", s.c_str());
+      for (const auto& s : r.text_list) std::printf("    text: %s\n", s.c_str());
+    }
+    if (per_key) {  // largest difference first, so the quantity that moved is on top
+      std::vector<std::pair<std::string, std::pair<double, long>>> keys(r.per_key.begin(), r.per_key.end());
+      std::stable_sort(keys.begin(), keys.end(), [](const auto& x, const auto& y) { return x.second.first > y.second.first; });
+      for (const auto& [key, v] : keys)
+        std::printf("    %-28s max rel diff %-10.3g (%ld numbers)\n", key.c_str(), v.first, v.second);
+    }
+    if (r.max_rel > tol || r.structural > 0) fail = true;
+    if (r.max_rel > overall) { overall = r.max_rel; overall_where = f + " " + r.max_path; }
+  }
+  for (const auto& f : new_files)
+    if (!std::binary_search(old_files.begin(), old_files.end(), f)) std::printf("%s: new (only in %s)\n", f.c_str(), new_dir.c_str());
+
+  std::printf("\noverall max rel diff %.3g (%s); tol %.3g; %ld files compared, %ld missing\n",
+              overall, overall_where.c_str(), tol, files_compared, missing);
+  if (unreadable) { std::printf("verdict: ERROR (unreadable JSON)\n"); return 2; }
+  std::printf("verdict: %s\n", fail ? "DIFFERENT (see above)" : "AGREE to tol");
+  return fail ? 1 : 0;
+}
