@@ -2,7 +2,10 @@
 // agree with those of a previous run to round-off. Used while refactoring: run the
 // studies into a fresh directory, then
 //
-//   compare_results OLD_DIR NEW_DIR [--tol 1e-9] [--ignore-key NAME]... [--per-key]
+//   compare_results OLD_DIR NEW_DIR [--tol 1e-9] [--atol 0] [--ignore-key NAME]... [--per-key]
+//
+// --atol A: numbers closer than A in absolute value count as equal (for values
+// that are themselves round-off, such as a discrete constraint of 1e-16).
 //
 // Every *.json file of OLD_DIR (sorted by name) is compared with NEW_DIR/<same name>;
 // both trees are walked in parallel. Numbers are compared by relative difference
@@ -60,6 +63,7 @@ struct Comparer {
   std::string file;
   std::set<std::string> extra_skip;  // from --ignore-key
   FileReport r;
+  double atol = 0.0;  // from --atol
 
   bool skipped(const std::string& key) const {
     return SKIP_KEYS.count(key) || extra_skip.count(key) || SKIP_KEYS_IN_FILE.count({file, key});
@@ -76,7 +80,7 @@ struct Comparer {
     if (a.is_number() && b.is_number()) {
       const double x = a.get<double>(), y = b.get<double>();
       double rel = 0.0;
-      if (x != y) rel = std::fabs(x - y) / std::max({std::fabs(x), std::fabs(y), 1e-300});
+      if (x != y && std::fabs(x - y) > atol) rel = std::fabs(x - y) / std::max({std::fabs(x), std::fabs(y), 1e-300});
       ++r.numbers;
       auto& pk = r.per_key[leaf.empty() ? "(root)" : leaf];
       pk.first = std::max(pk.first, rel);
@@ -135,24 +139,25 @@ static std::vector<std::string> json_files(const fs::path& dir) {
 }
 
 static int usage(const char* msg) {
-  std::fprintf(stderr, "%s\nusage: compare_results OLD_DIR NEW_DIR [--tol 1e-9] [--ignore-key NAME]... [--per-key]\n", msg);
+  std::fprintf(stderr, "%s\nusage: compare_results OLD_DIR NEW_DIR [--tol 1e-9] [--atol 0] [--ignore-key NAME]... [--per-key]\n", msg);
   return 2;
 }
 
 int main(int argc, char** argv) {
   std::vector<std::string> dirs;
-  double tol = 1e-9;
+  double tol = 1e-9, atol = 0.0;
   bool per_key = false;
   std::set<std::string> ignore;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--tol" || arg == "--ignore-key") {
+    if (arg == "--tol" || arg == "--atol" || arg == "--ignore-key") {
       if (i + 1 >= argc) return usage(("missing value after " + arg).c_str());
       const std::string val = argv[++i];
       if (arg == "--ignore-key") { ignore.insert(val); continue; }
       char* end = nullptr;
-      tol = std::strtod(val.c_str(), &end);
-      if (val.empty() || *end != '\0' || !(tol >= 0)) return usage(("bad --tol value: " + val).c_str());
+      const double x = std::strtod(val.c_str(), &end);
+      if (val.empty() || *end != '\0' || !(x >= 0)) return usage(("bad " + arg + " value: " + val).c_str());
+      (arg == "--tol" ? tol : atol) = x;
     } else if (arg == "--per-key") {
       per_key = true;
     } else if (arg.rfind("--", 0) == 0) {
@@ -177,7 +182,7 @@ int main(int argc, char** argv) {
     if (!fs::exists(new_dir / f)) { std::printf("%s: missing in %s\n", f.c_str(), new_dir.c_str()); ++missing; fail = true; continue; }
     json a, b;
     if (!load(old_dir / f, a) | !load(new_dir / f, b)) { unreadable = true; continue; }
-    Comparer c{f, ignore, {}};
+    Comparer c{f, ignore, {}, atol};
     std::string path;
     c.walk(a, b, path, "");
     const FileReport& r = c.r;

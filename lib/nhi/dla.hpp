@@ -51,11 +51,10 @@ struct DlaStepProblem {
   double h;
   const VecN& q_curr;
   const VecN& p_curr;
-  Mat<double, mc, n> W;    // force_forms(q_k)
-  Mat<double, n, mc> W_t;  // its transpose, the multiplier columns
+  Mat<double, n, mc> W_t;  // force_forms(q_k)^T: the multiplier columns
 
   DlaStepProblem(const S& s, const D& d, double hh, const VecN& q, const VecN& p)
-      : sys(s), disc(d), h(hh), q_curr(q), p_curr(p), W(force_forms(s, q)), W_t(W.transpose()) {}
+      : sys(s), disc(d), h(hh), q_curr(q), p_curr(p), W_t(force_forms(s, q).transpose()) {}
 
   // The one-forms the multipliers act on at q_k: omega(q_k) and, with holonomic
   // constraints, Dg(q_k) below it (eq. 17, first line).
@@ -85,8 +84,8 @@ struct DlaStepProblem {
       T force = cst<T>(0.0);
       double fscale = 0;
       for (int a = 0; a < mc; ++a) {
-        force += cst<T>(W(a, i)) * lambda[a];
-        fscale += std::abs(W(a, i) * value_of(lambda[a]));
+        force += cst<T>(W_t(i, a)) * lambda[a];
+        fscale += std::abs(W_t(i, a) * value_of(lambda[a]));
       }
       (*r)[i] = cst<T>(p_curr[i]) + D1[i] - force;  // eq. 6, first line
       if (terms) (*terms)[i] = std::abs(p_curr[i]) + std::abs(value_of(D1[i])) + fscale;
@@ -180,7 +179,7 @@ class DlaStepper {
 
   MethodTraits traits() const {
     MethodTraits t;
-    t.order = disc_order(map_.discretization());
+    t.order = map_.discretization().order();
     t.symmetric = map_.discretization().symmetric();
     t.symmetric_in_phase = false;  // positions only (see the top of this file)
     t.holds_velocity_constraint = false;
@@ -245,11 +244,6 @@ class DlaStepper {
   const VecM& lambda() const { return lambda_; }
 
  private:
-  template <class DD>
-  static int disc_order(const DD& d) {
-    return d.order();
-  }
-
   Map map_;
   std::optional<VecN> p0_;
   VecN q_prev_, q_curr_, q_next_, p_curr_, p_next_, v0_;
