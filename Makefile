@@ -33,8 +33,11 @@ FUZZ_PACKAGES := clang libclang-rt-14-dev
 deps-fuzz: deps
 	$(call APT,$(FUZZ_PACKAGES))
 
+# NATIVE=ON builds for this CPU (faster, but results are then this CPU's own;
+# see CMakeLists.txt).
+NATIVE ?= OFF
 build: deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DNHI_NATIVE=$(NATIVE)
 	cmake --build $(BUILD) -j$(JOBS)
 
 # A figure or study target asked for directly builds the binaries if they are missing.
@@ -76,14 +79,12 @@ RUNS := $(foreach s,particle_fig12 robot_fig34,$(foreach m,dla rk4 benchmark,res
 FIGURES := plots/fig1_particle_energy.png plots/fig2_particle_constraint.png \
            plots/fig3_robot_energy.png plots/fig4_robot_constraint.png
 
-STUDY_FIGURES := plots/convergence_particle.png plots/convergence_robot.png \
-                 plots/long_horizon_particle.png plots/long_horizon_robot.png \
-                 plots/stability_particle.png plots/stability_robot.png \
-                 plots/work_precision_particle.png plots/work_precision_robot.png
+# One figure per study and registered scene (see STUDY below).
+STUDY_TARGETS := study-convergence study-long-horizon study-stability study-work-precision
 
 GEOMETRY_FIGURES := plots/geometry_momentum.png plots/geometry_extrinsic.png
 
-figures: $(FIGURES) $(STUDY_FIGURES) $(GEOMETRY_FIGURES) results/step_costs.json results/summary.md
+figures: $(FIGURES) $(STUDY_TARGETS) $(GEOMETRY_FIGURES) results/step_costs.json results/summary.md
 
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
@@ -101,13 +102,15 @@ plots/fig4_robot_constraint.png: plots/constraint.gp plots/style.gp $(filter res
 	$(call PLOT,results/robot_fig34,Figure 4: mobile robot,2)
 
 # ---- Studies (issue 4): one executable, one JSON, one script each -------------
-SCENES := experiments/scenes/particle.json experiments/scenes/robot.json
+SCENES := $(wildcard experiments/scenes/*.json)
 
 # $(call STUDY,name,target): results/name.json from build/bin/study_name, and
-# plots/name_{particle,robot}.png from plots/name.gp.
+# plots/name_SCENE.png from plots/name.gp for every scene the JSON holds (every
+# registered system: the list comes from the result, not from this file).
 define STUDY
 .PHONY: $(2)
-$(2): plots/$(1)_particle.png plots/$(1)_robot.png
+$(2): results/$(1).json
+	$$(MAKE) --no-print-directory $$$$(jq -r '.scenes | keys_unsorted[] | "plots/$(1)_" + . + ".png"' $$<)
 plots/$(1)_%.png: plots/$(1).gp plots/style.gp results/$(1).json
 	gnuplot -e "file='results/$(1).json'; scene='$$*'; out='$$@'" $$< 2>&1 | { grep -v Skipping || true; }
 endef

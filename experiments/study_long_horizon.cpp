@@ -2,10 +2,11 @@
 // h = 0.2, T = 2e5 (10^6 steps) on every registered scene, for every library
 // method of nhi::study_methods(): the "main" ones (DLA alpha = 1/2, symmetric
 // DLA alpha = 0, RK4, the reference solution) and the "variant"s (alpha = 0,
-// 1/4, 3/4, 1; symmetric alpha = 1/4), whose energy fate the table states.  Nothing holds every step: the observer keeps, at ~40 log-spaced
-// checkpoints per decade, the instantaneous energy error and constraint value
-// and their running maxima over every step, plus block means of E - E0 over
-// blocks of 1000 steps for the drift rate.
+// 1/4, 3/4, 1; symmetric alpha = 1/4), whose energy fate the table states.
+// Nothing holds every step: the observer keeps, at ~40 log-spaced checkpoints
+// per decade, the instantaneous energy error and constraint value and their
+// running maxima over every step, plus block means of E - E0 over blocks of
+// 1000 steps for the drift rate.
 #include "study.hpp"
 
 namespace {

@@ -11,11 +11,12 @@ G='def g: if . == null then "-" elif . == 0 then "0" else
 
 echo "## Convergence (results/convergence.json): fitted order, 4 finest h above 1e-10"
 echo
-echo "| method | particle | robot |"
-echo "|---|---|---|"
+# One column per scene in the file (every registered scene), one row per method.
 jq -r "$G"'
-  [.scenes.particle.methods, .scenes.robot.methods] | transpose[] |
-  "| \(.[0].label) | \(.[0].fitted_order | g) | \(.[1].fitted_order | g) |"' "$R/convergence.json"
+  (.scenes | keys_unsorted) as $sc |
+  "| method | \($sc | join(" | ")) |", "|---|\($sc | map("---|") | join(""))",
+  ([.scenes[$sc[]].methods] | transpose[] |
+   "| \(.[0].label) | \(map(.fitted_order | g) | join(" | ")) |")' "$R/convergence.json"
 echo
 
 echo "## Long horizon (results/long_horizon.json): h = 0.2, T = 2e5"
