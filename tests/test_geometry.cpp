@@ -294,7 +294,7 @@ double restricted_defect(double eps) {
   const double h = 0.2;
   const AlphaDiscretization disc{0.5};
   const DlaMap<EpsParticle, AlphaDiscretization> st(sys, disc, h);
-  Vec<double, n> q(1.0, 0.5, 0.0), v(0.5, 1.0, 0.25 * eps), q1, p1, guess = q + h * v;
+  Vec<double, n> q(1.0, 0.5, 0.0), v(0.5, 1.0, 0.25 * eps), q1 = q, p1 = q, guess = q + h * v;
   Vec<double, n> p = momentum(sys, q, v);
   Vec<double, 1> lambda = Vec<double, 1>::Zero();
   const Eigen::MatrixXd Jm = canonical_form(n);

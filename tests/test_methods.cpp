@@ -121,7 +121,9 @@ TYPED_TEST(MethodContract, SymmetricMethodsAreReversibleAndOthersAreNot) {
           const double dz = (z2 - z0).cwiseAbs().maxCoeff() / scale;
           if (t.symmetric) {
             EXPECT_LE(dq, 64 * kEps) << m.label() << " h " << h;
-            if (t.symmetric_in_phase) EXPECT_LE(dz, 64 * kEps) << m.label() << " h " << h;
+            if (t.symmetric_in_phase) {
+              EXPECT_LE(dz, 64 * kEps) << m.label() << " h " << h;
+            }
           } else {
             EXPECT_GT(dq, 1e-9) << m.label() << " h " << h << ": a non-symmetric method returned";
           }
@@ -190,8 +192,9 @@ TYPED_TEST(MethodContract, ReportedSamplesAndSolvesAreWhatTheMethodPromises) {
         const double scale = 1.0 + s.q.cwiseAbs().maxCoeff() / h + s.v.cwiseAbs().maxCoeff();
         EXPECT_LE(s.discrete_constraint.cwiseAbs().maxCoeff(), 64 * kEps * scale) << sm.label() << " k " << k;
       }
-      if (t.holds_velocity_constraint)
+      if (t.holds_velocity_constraint) {
         EXPECT_LE(constraint_values(sys, s.q, s.v).cwiseAbs().maxCoeff(), 64 * kEps * (1 + s.v.cwiseAbs().maxCoeff()));
+      }
     }
   }
 }
