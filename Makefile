@@ -79,12 +79,29 @@ RUNS := $(foreach s,particle_fig12 robot_fig34,$(foreach m,dla rk4 benchmark,res
 FIGURES := plots/fig1_particle_energy.png plots/fig2_particle_constraint.png \
            plots/fig3_robot_energy.png plots/fig4_robot_constraint.png
 
+# ---- Companions to Figures 1-4 with the methods after the paper (issue 11) ----
+COMPANION_RUNS := $(foreach s,particle_fig12 robot_fig34,results/$(s)_mp06.json results/$(s)_mp06tj.json)
+COMPANION_FIGURES := plots/fig1b_particle_energy.png plots/fig2b_particle_constraint.png \
+                     plots/fig3b_robot_energy.png plots/fig4b_robot_constraint.png
+results/%_mp06.json: experiments/scenes/%.json $(NHI)
+	$(NHI) run $< --set method=mp06 -o $@
+results/%_mp06tj.json: experiments/scenes/%.json $(NHI)
+	$(NHI) run $< --set method=mp06 --set composition=triple_jump -o $@
+plots/fig1b_particle_energy.png: plots/energy_new.gp plots/style.gp $(filter results/particle_fig12_%,$(RUNS) $(COMPANION_RUNS))
+	$(call PLOT,results/particle_fig12,Figure 1b: nonholonomic particle,1)
+plots/fig2b_particle_constraint.png: plots/constraint_new.gp plots/style.gp $(filter results/particle_fig12_%,$(RUNS) $(COMPANION_RUNS))
+	$(call PLOT,results/particle_fig12,Figure 2b: nonholonomic particle,1)
+plots/fig3b_robot_energy.png: plots/energy_new.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS) $(COMPANION_RUNS))
+	$(call PLOT,results/robot_fig34,Figure 3b: mobile robot,2)
+plots/fig4b_robot_constraint.png: plots/constraint_new.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS) $(COMPANION_RUNS))
+	$(call PLOT,results/robot_fig34,Figure 4b: mobile robot,2)
+
 # One figure per study and registered scene (see STUDY below).
 STUDY_TARGETS := study-convergence study-long-horizon study-stability study-work-precision
 
 GEOMETRY_FIGURES := plots/geometry_momentum.png plots/geometry_extrinsic.png
 
-figures: $(FIGURES) $(STUDY_TARGETS) $(GEOMETRY_FIGURES) results/step_costs.json results/summary.md
+figures: $(FIGURES) $(COMPANION_FIGURES) $(STUDY_TARGETS) $(GEOMETRY_FIGURES) results/step_costs.json results/summary.md
 
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
@@ -131,7 +148,8 @@ plots/geometry_%.png: plots/geometry_%.gp plots/style.gp results/geometry.json
 # Timed studies run after the others (order-only prerequisites), so that no
 # other job shares the two cores while they measure CPU time.
 results/work_precision.json: $(BUILD)/bin/study_work_precision $(SCENES) \
-    | results/convergence.json results/long_horizon.json results/stability.json results/geometry.json $(RUNS)
+    | results/convergence.json results/long_horizon.json results/stability.json results/geometry.json $(RUNS) \
+      $(COMPANION_RUNS)
 	$< --threads $(JOBS) -o $@
 study-work-precision: results/step_costs.json
 
@@ -140,7 +158,7 @@ results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 	$< --benchmark_min_time=0.5 -o $@
 
 # Markdown tables of the study results, quoted in README.md.
-results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json \
+results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json \
     results/stability.json results/step_costs.json
 	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
 

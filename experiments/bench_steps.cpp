@@ -181,7 +181,7 @@ void register_all() {
   nhi::for_each_type(nhi::Systems{}, [](auto tag) {
     using S = typename decltype(tag)::type;
     for (const nhi::StudyMethod& m : nhi::study_methods()) {
-      if (m.external || m.spec.kind == "benchmark" || m.group != "main") continue;
+      if (m.external || m.spec.kind == "benchmark") continue;  // every fixed-step method, variants too
       std::string name = std::string(S::name) + "/" + m.label();
       std::replace(name.begin(), name.end(), ' ', '_');
       const nhi::MethodSpec spec = m.spec;

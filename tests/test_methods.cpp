@@ -67,7 +67,8 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
   for (const StudyMethod& m : fixed_step_methods()) {
     const int p = method_traits(sys, m.spec).order;
     std::vector<double> hs, eq, ev, eE;
-    for (double h = 0.1; h > 0.003; h /= 2) {
+    // Order 6 reaches the floor 1e-10 by h ~ 0.01: start it at 0.4 for enough points above it.
+    for (double h = p >= 6 ? 0.4 : 0.1; h > 0.003; h /= 2) {
       const Final<S> f = run_to_end(sys, m.spec, q0, v0, h, std::lround(T / h));
       ASSERT_TRUE(f.rep.ok) << m.label() << ": " << f.rep.reason;
       hs.push_back(h);
@@ -86,7 +87,7 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
     // energy error at T = 4 is partly below the floor and pre-asymptotic, so it
     // is not fitted; a first-order velocity formula in a second-order method fails).
     EXPECT_GT(*fv.order, p - tol) << m.label() << " (the reported velocity)";
-    if (p <= 2) {
+    if (p <= 2 && !method_traits(sys, m.spec).preserves_energy) {  // (an energy-preserving method's is round-off)
       ASSERT_TRUE(fE.order) << m.label();
       EXPECT_GT(*fE.order, p - tol) << m.label() << " (energy)";
     }
@@ -175,16 +176,20 @@ TYPED_TEST(MethodContract, ReportedSamplesAndSolvesAreWhatTheMethodPromises) {
     ASSERT_TRUE(rep.ok) << sm.label() << ": " << rep.reason;
     ASSERT_EQ(samples.size(), 401u);
     const MethodTraits t = method_traits(sys, sm.spec);
-    EXPECT_EQ(samples[0].v, v0) << sm.label();
-    if (t.implicit) {
+    if (sm.spec.kind == "dla" || sm.spec.kind == "rk4") {
+      EXPECT_EQ(samples[0].v, v0) << sm.label();
+    } else {  // v_0 = V(q_0, p_0) with p_0 = dL/dqdot(q_0, v_0)
+      EXPECT_LE((samples[0].v - v0).cwiseAbs().maxCoeff(), 4 * kEps * (1 + v0.cwiseAbs().maxCoeff())) << sm.label();
+    }
+    if (t.implicit) {  // per one-step solve (a composition makes `stages` of them per step)
       EXPECT_EQ(rep.fallbacks, 0) << sm.label();
-      EXPECT_LE(double(rep.newton_iterations) / rep.steps_taken, 4.0) << sm.label();
+      EXPECT_LE(double(rep.newton_iterations) / (double(rep.steps_taken) * t.stages), 4.0) << sm.label();
     }
     for (size_t k = 0; k < samples.size(); ++k) {
       const auto& s = samples[k];
       EXPECT_EQ(s.k, long(k));
-      if (s.has_p) {  // the DLA
-        if (k >= 1 && k + 1 < samples.size()) {
+      if (s.has_p) {  // methods on (q, p): their discrete (or held) constraint is at round-off
+        if (sm.spec.kind == "dla" && sm.spec.composition == "none" && k >= 1 && k + 1 < samples.size()) {
           // samples[k+1].q is q_{k+1}: v_k = (q_{k+1} - q_{k-1}) / 2h exactly.
           const Vec<double, n> central = (samples[k + 1].q - samples[k - 1].q) / (2 * h);
           EXPECT_EQ(s.v, central) << sm.label() << " k " << k;
@@ -233,7 +238,8 @@ TYPED_TEST(ReversibleSceneContract, SymmetricMethodsKeepTheEnergyBounded) {
   const double E0 = energy(sys, q0, v0);
   const long steps = 20000;
   for (const StudyMethod& m : fixed_step_methods()) {
-    if (!method_traits(sys, m.spec).symmetric) continue;
+    const MethodTraits t = method_traits(sys, m.spec);
+    if (!t.symmetric || t.preserves_energy) continue;  // (energy-preserving: EnergyPreservingMethodsKeepItToRoundOff)
     double first = 0, last = 0;
     const RunReport rep = run_method(sys, m.spec, q0, v0, 0.2, steps, [&](const Sample<S::n, S::m>& s) {
       const double dE = std::abs(energy(sys, s.q, s.v) - E0);
@@ -244,6 +250,40 @@ TYPED_TEST(ReversibleSceneContract, SymmetricMethodsKeepTheEnergyBounded) {
     ASSERT_TRUE(rep.ok) << m.label() << ": " << rep.reason;
     EXPECT_LE(last, 1.1 * first) << m.label() << ": first quarter " << first << ", last " << last;
   }
+}
+
+// Methods that declare preserves_energy keep |E_k - E_0| at round-off over
+// 10^4 steps of h = 0.2 (issue 11), on every scene.  Round-off here is a
+// linear accumulation of a few eps of the energy's terms per step: the step
+// equations are solved to their rounding floor, which leaves each step's
+// energy change at a few eps of |T| + |U| (kinetic and potential parts, the
+// robot's potential swings to 10 while E = 1.5), and those errors do not
+// cancel.  Measured: particle 3.2e-14, robot 2.2e-11 (largest single step
+// 7e-13); the bound below is 4 eps (|T| + |U|)_max per step, N steps.
+// A second-order method that does not preserve it has 1e-3 ... 1e-1 here.
+TYPED_TEST(MethodContract, EnergyPreservingMethodsKeepItToRoundOff) {
+  using S = TypeParam;
+  const S sys = make_system<S>();
+  const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
+  const double E0 = energy(sys, q0, v0);
+  const long steps = 10000;
+  int checked = 0;
+  for (const StudyMethod& m : fixed_step_methods()) {
+    if (!method_traits(sys, m.spec).preserves_energy || m.group != "main") continue;
+    double worst = 0, scale = 0;
+    const RunReport rep = run_method(sys, m.spec, q0, v0, 0.2, steps, [&](const Sample<S::n, S::m>& s) {
+      const double E = energy(sys, s.q, s.v), T = 0.5 * momentum(sys, s.q, s.v).dot(s.v);
+      worst = std::max(worst, std::abs(E - E0));
+      scale = std::max(scale, std::abs(T) + std::abs(E - T));
+      return true;
+    });
+    ASSERT_TRUE(rep.ok) << m.label() << ": " << rep.reason;
+    const double bound = 4 * kEps * scale * steps;
+    std::printf("    %-30s max |E - E0| over 1e4 steps: %.3g (bound %.3g)\n", m.label().c_str(), worst, bound);
+    EXPECT_LE(worst, bound) << m.label();
+    ++checked;
+  }
+  EXPECT_GE(checked, 1);
 }
 
 // AlphaDiscretization{a} and SplitDiscretization{a, a} are the same method: identical runs.

@@ -20,6 +20,20 @@ TEST(Scene, ResolvesDefaults) {
   EXPECT_EQ(r["output_every"], 1);
   EXPECT_EQ(r["params"]["kx"], 1.0);
   EXPECT_EQ(r["params"]["ky"], 1.0);
+  EXPECT_EQ(r["composition"], "none");
+}
+
+// The methods after the paper (issue 11) and their compositions resolve.
+TEST(Scene, NewMethodsAndCompositionsResolve) {
+  for (const char* method : {"mp06", "discrete_gradient", "dla"})
+    for (const char* c : {"none", "triple_jump", "suzuki5", "order6"}) {
+      json s = good();
+      s["method"] = method;
+      s["composition"] = c;
+      const json r = validate_scene(s);
+      EXPECT_EQ(r["method"], method);
+      EXPECT_EQ(r["composition"], c);
+    }
 }
 
 struct Bad {
@@ -72,6 +86,10 @@ TEST(Scene, RejectsBadInputNamingTheKey) {
       {"tolerance zero", "tolerance", [](json& s) { s["tolerance"] = 0; }},
       {"output_every zero", "output_every", [](json& s) { s["output_every"] = 0; }},
       {"NaN entry", "v0[0]", [](json& s) { s["v0"][0] = std::nan(""); }},
+      {"composition of a non-symmetric DLA", "composition", [](json& s) { s["alpha"] = 0.25; s["composition"] = "triple_jump"; }},
+      {"composition of rk4", "composition", [](json& s) { s["method"] = "rk4"; s["composition"] = "order6"; }},
+      {"unknown composition", "composition", [](json& s) { s["method"] = "mp06"; s["composition"] = "order8"; }},
+      {"composition not a string", "composition", [](json& s) { s["method"] = "mp06"; s["composition"] = 4; }},
       // make fuzz found this one: the message's dump() threw on invalid UTF-8.
       {"string with invalid UTF-8 (--set fallback)", "params.kx",
        [](json& s) { apply_override(&s, "params.kx=\x86\x86\x86"); }},

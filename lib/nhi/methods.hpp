@@ -4,52 +4,56 @@
 // A *method* is a plain type in the TypeList `Methods` below with
 //   static constexpr const char* name;          // the scene's "method" value
 //   static constexpr bool uses_discretization;  // reads MethodSpec::discretization, alpha
+//   static bool symmetric(const MethodSpec&);   // self-adjoint: then it accepts a
+//                                               // MethodSpec::composition (composition.hpp)
+//   static constexpr bool reports_p;            // its samples carry p and lambda
 //   template <class S, class F> static auto with_stepper(const S&, const MethodSpec&, F&& f);
+//   static std::vector<StudyEntry> study_entries();   // what the studies run of it
 // which builds the stepper the spec describes and returns f(stepper).  Adding a
-// method is one header (its stepper and this small struct) and one entry in
-// `Methods`; it then runs through `nhi run`, and through every study that
-// takes its methods from study_methods() once it has an entry there.
+// method is one header (its stepper and this small struct, e.g. mp06.hpp) and
+// one entry in `Methods` (with its #include); it then runs through `nhi run`,
+// every study (study_methods() below), bench_steps and the typed method-contract
+// tests (tests/test_methods.cpp).
 #pragma once
 
-#include <cstdio>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
 
+#include "nhi/discrete_gradient.hpp"
+#include "nhi/dla_composition.hpp"
 #include "nhi/integrate.hpp"
+#include "nhi/method_spec.hpp"
+#include "nhi/mp06.hpp"
 #include "nhi/typelist.hpp"
 
 namespace nhi {
 
-// A method as a scene or a study names it.
-struct MethodSpec {
-  std::string kind = "dla";              // a Methods name: "dla", "rk4", "benchmark"
-  std::string discretization = "alpha";  // DLA: "alpha" or "symmetric"
-  double alpha = 0.5;
-  double tolerance = 1e-12;  // implicit methods: relative residual; the reference: CVODE rtol = atol
-
-  // The one label scheme: "dla a=0.5", "dla-sym a=0", "rk4", "reference".
-  std::string label() const {
-    char buf[64];
-    if (kind == "dla")
-      std::snprintf(buf, sizeof buf, "%s a=%g", discretization == "alpha" ? "dla" : "dla-sym", alpha);
-    else if (kind == "benchmark")
-      std::snprintf(buf, sizeof buf, "reference");
-    else
-      std::snprintf(buf, sizeof buf, "%s", kind.c_str());
-    return buf;
-  }
-};
-
 struct DlaMethod {
   static constexpr const char* name = "dla";
   static constexpr bool uses_discretization = true;
+  static constexpr bool reports_p = true;
+  // Self-adjoint discretizations (alpha = 1/2, the symmetric family) compose:
+  // dla_composition.hpp, README "The paper's DLA composed".
+  static bool symmetric(const MethodSpec& spec) {
+    return spec.discretization == "symmetric" || (spec.discretization == "alpha" && spec.alpha == 0.5);
+  }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
     DlaOptions opt;
     opt.tolerance = spec.tolerance;
+    if (spec.composition != "none") {
+      if (!symmetric(spec)) throw std::invalid_argument("the DLA composes only with a self-adjoint discretization");
+      const Composition& c = composition(spec.composition);
+      if (spec.discretization == "alpha") {
+        ComposedDla<S, AlphaDiscretization> st(sys, AlphaDiscretization{spec.alpha}, opt, c);
+        return f(st);
+      }
+      ComposedDla<S, SymmetricDiscretization> st(sys, SymmetricDiscretization{spec.alpha}, opt, c);
+      return f(st);
+    }
     if (spec.discretization == "alpha") {
       DlaStepper<S, AlphaDiscretization> st(sys, AlphaDiscretization{spec.alpha}, opt);
       return f(st);
@@ -59,22 +63,40 @@ struct DlaMethod {
     DlaStepper<S, SymmetricDiscretization> st(sys, SymmetricDiscretization{spec.alpha}, opt);
     return f(st);
   }
+  static std::vector<StudyEntry> study_entries() {
+    auto dla = [](const char* disc, double alpha, const char* group) {
+      MethodSpec s;
+      s.discretization = disc;
+      s.alpha = alpha;
+      return StudyEntry{s, group};
+    };
+    StudyEntry tj = dla("alpha", 0.5, "main"), tj_sym = dla("symmetric", 0.0, "variant");
+    tj.spec.composition = tj_sym.spec.composition = "triple_jump";
+    return {dla("alpha", 0.5, "main"),     dla("symmetric", 0.0, "main"),   dla("alpha", 0.0, "variant"),
+            dla("alpha", 0.25, "variant"), dla("alpha", 0.75, "variant"),   dla("alpha", 1.0, "variant"),
+            dla("symmetric", 0.25, "variant"), tj, tj_sym};
+  }
 };
 
 struct Rk4Method {
   static constexpr const char* name = "rk4";
   static constexpr bool uses_discretization = false;
+  static constexpr bool reports_p = false;
+  static bool symmetric(const MethodSpec&) { return false; }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec&, F&& f) {
     Rk4Stepper<S> st(sys);
     return f(st);
   }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name)}}; }
 };
 
 // The reference solution (scene value "benchmark", kept for the runner's contract).
 struct ReferenceMethod {
   static constexpr const char* name = "benchmark";
   static constexpr bool uses_discretization = false;
+  static constexpr bool reports_p = false;
+  static bool symmetric(const MethodSpec&) { return false; }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
     ReferenceOptions opt;
@@ -82,15 +104,49 @@ struct ReferenceMethod {
     ReferenceStepper<S> st(sys, opt);
     return f(st);
   }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name)}}; }
 };
 
 // Every method the library has.
-using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod>;
+using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod, Mp06Method, DiscreteGradientMethod>;
 
 inline std::vector<std::string> method_names() {
   std::vector<std::string> names;
   for_each_type(Methods{}, [&](auto tag) { names.push_back(decltype(tag)::type::name); });
   return names;
+}
+
+// f(M{}) for the method type named `kind` (throws for an unknown name).
+template <class F>
+void with_method_type(const std::string& kind, F&& f) {
+  bool found = false;
+  for_each_type(Methods{}, [&](auto tag) {
+    if (!found && kind == decltype(tag)::type::name) {
+      found = true;
+      f(tag);
+    }
+  });
+  if (!found) throw std::invalid_argument("unknown method \"" + kind + "\"");
+}
+
+// The method's declared flags, by name.
+struct MethodFlags {
+  bool uses_discretization = false, reports_p = false;
+};
+inline MethodFlags method_flags(const std::string& kind) {
+  MethodFlags fl;
+  with_method_type(kind, [&](auto tag) {
+    using M = typename decltype(tag)::type;
+    fl = {M::uses_discretization, M::reports_p};
+  });
+  return fl;
+}
+
+// Is the method the spec names self-adjoint (and so composable)?
+inline bool method_is_symmetric(const MethodSpec& spec) {
+  bool sym = false;
+  with_method_type(spec.kind, [&](auto tag) { sym = decltype(tag)::type::symmetric(spec); });
+  return sym;
 }
 
 // f(stepper) for the stepper spec names; an unknown name is an error, never a fallback.
@@ -119,12 +175,15 @@ MethodTraits method_traits(const S& sys, const MethodSpec& spec) {
   return with_stepper(sys, spec, [](auto& stepper) { return stepper.traits(); });
 }
 
-// The methods the studies run, in a fixed order: the position in this list is
-// the method's style (colour and point type) in plots/style.gp, in every figure.
-// "main" methods are in every study; "variant"s (the paper's other alphas) in
-// those that sweep alpha.  Entries with external = true are not library methods
-// (Boost.Odeint's adaptive pairs, run by the work-precision study only); they
-// are listed here so that their label and style are fixed in the same place.
+// The methods the studies run, in a fixed order: every method's "main"
+// study_entries() in the order of `Methods`, then every "variant", then the
+// external ones.  The position in this list is the method's style (colour and
+// point type) in plots/style.gp, in every figure.  "main" methods are in every
+// study; "variant"s (the paper's other alphas, the costlier compositions) in
+// those that sweep them.  Entries with external = true are not library methods
+// (Boost.Odeint's adaptive pairs, run by the work-precision study only; their
+// spec names a kind no method has, so it cannot be run by mistake); they are
+// listed here so that their label and style are fixed in the same place.
 struct StudyMethod {
   MethodSpec spec;
   std::string group;  // "main" or "variant"
@@ -135,19 +194,17 @@ struct StudyMethod {
 };
 
 inline const std::vector<StudyMethod>& study_methods() {
-  static const std::vector<StudyMethod> list = {
-      {{"dla", "alpha", 0.5}, "main", false, ""},
-      {{"dla", "symmetric", 0.0}, "main", false, ""},
-      {{"rk4"}, "main", false, ""},
-      {{"benchmark", "alpha", 0.5, 1e-12}, "main", false, ""},
-      {{"dla", "alpha", 0.0}, "variant", false, ""},
-      {{"dla", "alpha", 0.25}, "variant", false, ""},
-      {{"dla", "alpha", 0.75}, "variant", false, ""},
-      {{"dla", "alpha", 1.0}, "variant", false, ""},
-      {{"dla", "symmetric", 0.25}, "variant", false, ""},
-      {{}, "main", true, "rkf78"},
-      {{}, "main", true, "dopri5"},
-  };
+  static const std::vector<StudyMethod> list = [] {
+    std::vector<StudyMethod> out;
+    for (const char* group : {"main", "variant"})
+      for_each_type(Methods{}, [&](auto tag) {
+        for (const StudyEntry& e : decltype(tag)::type::study_entries())
+          if (e.group == group) out.push_back({e.spec, e.group, false, ""});
+      });
+    out.push_back({spec_of("rkf78"), "main", true, "rkf78"});
+    out.push_back({spec_of("dopri5"), "main", true, "dopri5"});
+    return out;
+  }();
   return list;
 }
 

@@ -4,12 +4,16 @@
 //   system         "particle" | "robot"                         (required)
 //   params         object of system parameters                  (default: the system's)
 //   q0, v0         arrays of n numbers; v0 must satisfy omega(q0) v0 = 0   (required)
-//   method         "dla" | "rk4" | "benchmark"                   (required)
+//   method         "dla" | "rk4" | "benchmark" | "mp06" | "discrete_gradient"   (required)
+//   composition    "none" | "triple_jump" | "suzuki5" | "order6"  (default "none");
+//                  anything but "none" only with a symmetric method: mp06,
+//                  discrete_gradient, dla with alpha 0.5 or discretization "symmetric"
 //   discretization "alpha" | "symmetric"                         (default "alpha")
 //   alpha          number in [0, 1]                              (default 0.5)
+//                  (discretization and alpha are the DLA's; other methods ignore them)
 //   h              number > 0                                    (required)
 //   steps          integer >= 1                                  (required)
-//   tolerance      number in (0, 1): DLA relative residual (default 1e-12),
+//   tolerance      number in (0, 1): implicit methods' relative residual (default 1e-12),
 //                  CVODE rtol = atol for the benchmark (default 1e-12); unused by rk4
 //   output_every   integer >= 1: record steps 0, s, 2s, ... and the last (default 1)
 // Every number must be finite and at most 1e100 in magnitude.

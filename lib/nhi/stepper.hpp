@@ -69,6 +69,8 @@ struct MethodTraits {
   bool holds_velocity_constraint = false;  // omega(q_k) v_k = 0 at grid points to round-off
   bool implicit = false;
   bool adaptive = false;          // h is only the output interval
+  bool preserves_energy = false;  // E(q_k, v_k) = E(q_0, v_0) to round-off for every h
+  int stages = 1;                 // one-step solves per step (a composition's stage count)
 };
 
 // One reported time point.

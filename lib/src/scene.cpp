@@ -22,7 +22,7 @@ using namespace scene_detail;
 
 const std::vector<std::string> kKeys = {"system", "params", "q0",    "v0",        "method",
                                         "discretization", "alpha", "h", "steps", "tolerance",
-                                        "output_every"};
+                                        "output_every", "composition"};
 
 long peak_rss_kb() {
   rusage ru{};
@@ -53,6 +53,7 @@ json run_system(const S& sys, const json& sc) {
   spec.discretization = sc["discretization"];
   spec.alpha = alpha;
   spec.tolerance = tol;
+  spec.composition = sc["composition"];
   const RunReport rep = run_method(sys, spec, q0, v0, h, steps, rec);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu = cpu_seconds() - cpu0;
@@ -107,7 +108,7 @@ double estimated_bytes_per_point(int n, int m, bool has_p) {
 void refuse_if_too_large(const json& r, int n, int m) {
   const long steps = r["steps"], every = r["output_every"];
   const double points = double(steps / every) + 2;
-  const double bytes = points * estimated_bytes_per_point(n, m, r["method"] == "dla");
+  const double bytes = points * estimated_bytes_per_point(n, m, method_flags(r["method"]).reports_p);
   const double avail = available_bytes();
   if (bytes > avail) {
     const double per_point = bytes / points;
@@ -187,6 +188,19 @@ json validate_scene(const json& scene) {
   const double alpha = scene.contains("alpha") ? finite_number(scene["alpha"], "alpha") : 0.5;
   if (!(alpha >= 0.0 && alpha <= 1.0)) fail("alpha", "must be in [0, 1], got " + show(scene["alpha"]));
   r["alpha"] = alpha;
+  r["composition"] = scene.contains("composition")
+                         ? one_of(scene["composition"], "composition", composition_names())
+                         : "none";
+  if (r["composition"] != "none") {
+    MethodSpec spec;
+    spec.kind = r["method"];
+    spec.discretization = r["discretization"];
+    spec.alpha = alpha;
+    if (!method_is_symmetric(spec))
+      fail("composition", "\"" + r["composition"].get<std::string>() +
+                              "\" composes only symmetric methods (mp06, discrete_gradient, dla with alpha = 0.5 "
+                              "or discretization \"symmetric\"), not " + spec.label());
+  }
   const double h = finite_number(scene["h"], "h");
   if (!(h > 0)) fail("h", "must be > 0, got " + show(scene["h"]));
   r["h"] = h;

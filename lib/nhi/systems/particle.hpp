@@ -34,6 +34,8 @@ struct Particle {
   // L and omega are invariant under (q, v) -> (q, -v): the standard reversing symmetry.
   static constexpr bool reversible = true;
   static constexpr const char* paper_section = "6.1";
+  // L = 1/2 v^T M v - U(q) with M constant (hamiltonian.hpp).
+  static constexpr bool separable = true;
 
   double kx = 1.0;  // potential V = kx x^2 + ky y^2
   double ky = 1.0;
@@ -56,6 +58,12 @@ struct Particle {
   void partials(const Vec<T, 3>& q, const Vec<T, 3>& v, Vec<T, 3>* dLdq, Vec<T, 3>* dLdv) const {
     *dLdq << cst<T>(-2.0 * kx) * q[0], cst<T>(-2.0 * ky) * q[1], cst<T>(0.0);
     *dLdv = v;
+  }
+
+  // The inverse Legendre map V(q, p) = p (fast path; checked against the generic one).
+  template <class T>
+  Vec<T, 3> velocity(const Vec<T, 3>&, const Vec<T, 3>& p) const {
+    return p;
   }
 
   template <class T>

@@ -44,6 +44,8 @@ struct Robot {
   // L and omega are invariant under (q, v) -> (q, -v): the standard reversing symmetry.
   static constexpr bool reversible = true;
   static constexpr const char* paper_section = "6.2";
+  // L = 1/2 v^T M v - U(q) with M constant (hamiltonian.hpp).
+  static constexpr bool separable = true;
 
   double mass = 1.0;  // m
   double I = 1.0;
@@ -75,6 +77,14 @@ struct Robot {
     using std::cos;
     *dLdq << cst<T>(0.0), cst<T>(0.0), cst<T>(0.0), -cst<T>(V0) * cos(q[3]);
     *dLdv << cst<T>(mass) * v[0], cst<T>(mass) * v[1], cst<T>(I) * v[2], cst<T>(3.0 * Iw) * v[3];
+  }
+
+  // The inverse Legendre map V(q, p) = M^-1 p (fast path; checked against the generic one).
+  template <class T>
+  Vec<T, 4> velocity(const Vec<T, 4>&, const Vec<T, 4>& p) const {
+    Vec<T, 4> v;
+    v << p[0] / cst<T>(mass), p[1] / cst<T>(mass), p[2] / cst<T>(I), p[3] / cst<T>(3.0 * Iw);
+    return v;
   }
 
   template <class T>

@@ -1,0 +1,224 @@
+// An energy-preserving nonholonomic scheme from Gonzalez's midpoint discrete
+// gradient (O. Gonzalez, "Time integration and discrete Hamiltonian systems",
+// J. Nonlinear Sci. 6, 1996, eq. 3.6; the nonholonomic form with the
+// codistribution at the midpoint is also odelab's NonHolonomicEnergy).  With
+// z = (q, p), zbar = (z0 + z1)/2, dz = z1 - z0 and H from hamiltonian.hpp:
+//     gradbar H(z0, z1) = grad H(zbar) + [H(z1) - H(z0) - grad H(zbar) . dz] / |dz|^2  dz
+// so that H(z1) - H(z0) = gradbar H . dz exactly; grad H = (-F(q, p), V(q, p)).
+// One step solves, for (q1, p1, lambda), with qbar = (q0 + q1)/2:
+//     (q1 - q0)/h =  gradbar_p H
+//     (p1 - p0)/h = -gradbar_q H + omega(qbar)^T lambda
+//     omega(qbar) gradbar_p H = 0
+// Then H(z1) - H(z0) = h lambda . omega(qbar) gradbar_p H = 0: the energy is
+// preserved to round-off for every h; the velocity constraint holds only in
+// the averaged form of the third line.  Symmetric (exchanging z0, z1 and h -> -h
+// leaves the equations unchanged) and of order 2.
+//
+// The constraint rows omega(qbar) move with q1, so lambda is one more unknown of
+// a plain Newton solve (NewtonSolver with nl = 0, LU of the whole Jacobian).
+#pragma once
+
+#include <string>
+
+#include "nhi/composition.hpp"
+#include "nhi/hamiltonian.hpp"
+#include "nhi/method_spec.hpp"
+#include "nhi/solver.hpp"
+
+namespace nhi {
+
+template <class S>
+struct DiscreteGradientProblem {
+  static constexpr int n = S::n, m = S::m;
+  static constexpr int ny = 2 * n + m, nl = 0;
+  using VecN = Vec<double, n>;
+
+  const S& sys;
+  double h;
+  VecN q0, p0;
+  double H0;
+  Mat<double, ny, nl> W_t;  // empty: lambda is part of y
+
+  DiscreteGradientProblem(const S& s, double hh, const VecN& q, const VecN& p)
+      : sys(s), h(hh), q0(q), p0(p), H0(hamiltonian<S, double>(s, q, p)) {}
+
+  const Mat<double, ny, nl>& Wt() const { return W_t; }
+
+  Vec<double, ny> y_scale(const Vec<double, ny>& y) const {
+    Vec<double, ny> s;
+    s << q0.cwiseAbs() + y.template head<n>().cwiseAbs(), p0.cwiseAbs() + y.template segment<n>(n).cwiseAbs(),
+        y.template tail<m>().cwiseAbs();
+    return s;
+  }
+
+  // gradbar H(z0, z1) as (gradbar_q, gradbar_p).
+  template <class T>
+  void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp) const {
+    const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1), pb = cst<T>(0.5) * (p0.template cast<T>() + p1);
+    const Vec<T, n> gq = -force(sys, qb, pb), gp = velocity(sys, qb, pb);
+    const Vec<T, n> dq = q1 - q0.template cast<T>(), dp = p1 - p0.template cast<T>();
+    const T den = dq.squaredNorm() + dp.squaredNorm();
+    *Dq = gq;
+    *Dp = gp;
+    if (value_of(den) > 0) {  // Gonzalez's correction along dz (eq. 3.6)
+      const T H1 = hamiltonian(sys, q1, p1);
+      const T c = (H1 - cst<T>(H0) - gq.dot(dq) - gp.dot(dp)) / den;
+      *Dq += c * dq;
+      *Dp += c * dp;
+    }
+  }
+
+  template <class T>
+  void residual(const Vec<T, ny>& y, const Vec<T, nl>&, Vec<T, ny>* r, Vec<double, ny>* terms) const {
+    const Vec<T, n> q1 = y.template head<n>(), p1 = y.template segment<n>(n);
+    const Vec<T, m> lambda = y.template tail<m>();
+    Vec<T, n> Dq, Dp;
+    discrete_gradient(q1, p1, &Dq, &Dp);
+    const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1);
+    const Mat<T, m, n> Wb = sys.template omega<T>(qb);
+    const Vec<T, n> fc = Wb.transpose() * lambda;
+    for (int i = 0; i < n; ++i) {
+      (*r)[i] = q1[i] - cst<T>(q0[i]) - cst<T>(h) * Dp[i];                        // (q1 - q0)/h = gradbar_p H
+      (*r)[n + i] = p1[i] - cst<T>(p0[i]) + cst<T>(h) * (Dq[i] - fc[i]);          // (p1 - p0)/h = -gradbar_q H + omega^T lambda
+      if (terms) {
+        (*terms)[i] = std::abs(value_of(q1[i])) + std::abs(q0[i]) + std::abs(h * value_of(Dp[i]));
+        double fs = 0;
+        for (int a = 0; a < m; ++a) fs += std::abs(value_of(Wb(a, i)) * value_of(lambda[a]));
+        (*terms)[n + i] = std::abs(value_of(p1[i])) + std::abs(p0[i]) + std::abs(h) * (std::abs(value_of(Dq[i])) + fs);
+      }
+    }
+    for (int a = 0; a < m; ++a) {  // omega(qbar) gradbar_p H = 0
+      T c = cst<T>(0.0);
+      double cs = 0;
+      for (int j = 0; j < n; ++j) {
+        c += Wb(a, j) * Dp[j];
+        cs += std::abs(value_of(Wb(a, j)) * value_of(Dp[j]));
+      }
+      (*r)[2 * n + a] = c;
+      if (terms) (*terms)[2 * n + a] = cs;
+    }
+  }
+};
+
+// The stateful discrete-gradient stepper (stepper.hpp), lag 0.
+template <class S>
+class DiscreteGradientStepper {
+ public:
+  static constexpr int n = S::n, m = S::m;
+  static constexpr int lag = 0;
+  using VecN = Vec<double, n>;
+  using VecM = Vec<double, m>;
+  using Problem = DiscreteGradientProblem<S>;
+
+  explicit DiscreteGradientStepper(const S& sys, SolverOptions options = {}) : sys_(sys), options_(options) {}
+  const S& system() const { return sys_; }
+
+  MethodTraits traits() const {
+    MethodTraits t;
+    t.order = 2;
+    t.symmetric = true;
+    t.symmetric_in_phase = true;
+    t.holds_velocity_constraint = false;
+    t.implicit = true;
+    t.preserves_energy = true;
+    return t;
+  }
+
+  void start(const VecN& q0, const VecN& v0) {
+    q_ = q0;
+    p_ = momentum(sys_, q0, v0);
+    lambda_ = VecM::Zero();
+    wd_ = VecM::Zero();
+    steps_ = 0;
+  }
+
+  // One step (q0, p0) -> (q1, p1); lambda holds the guess and gets the multiplier.
+  StepSummary map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecM* lambda) const {
+    const Problem prob(sys_, h, q0, p0);
+    // Guess: an explicit Stoermer-Verlet-like step with the last multiplier
+    // (second order when lambda is), so Newton starts close.
+    const VecN qh = q0 + 0.5 * h * velocity<S, double>(sys_, q0, p0);
+    const VecN p1 = p0 + h * (force<S, double>(sys_, qh, p0) + sys_.template omega<double>(qh).transpose() * *lambda);
+    Vec<double, Problem::ny> y;
+    y << qh + 0.5 * h * velocity<S, double>(sys_, qh, p1), p1, *lambda;
+    Vec<double, 0> none;
+    StepSummary s = NewtonSolver<Problem>(prob, options_).solve(&y, &none);
+    if (s.ok()) {
+      *q1 = y.template head<n>();
+      *p1 = y.template segment<n>(n);
+      *lambda = y.template tail<m>();
+    }
+    return s;
+  }
+
+  StepSummary step(double h) {
+    VecN q1, p1;
+    VecM lambda = lambda_;
+    StepSummary s = map(h, q_, p_, &q1, &p1, &lambda);
+    ++steps_;
+    if (s.ok() && !(q1.allFinite() && p1.allFinite())) {
+      s.status = SolveStatus::kFailed;
+      s.failure = FailureKind::kNonFinite;
+      s.message = "non-finite state";
+    }
+    if (!s.ok()) {
+      s.message = "discrete_gradient step " + std::to_string(steps_) + " did not converge: " + s.message;
+      return s;
+    }
+    // The averaged constraint of this step, omega(qbar) gradbar_p H (zero to round-off).
+    const Problem prob(sys_, h, q_, p_);
+    VecN Dq, Dp;
+    prob.template discrete_gradient<double>(q1, p1, &Dq, &Dp);
+    wd_ = sys_.template omega<double>(VecN(0.5 * (q_ + q1))) * Dp;
+    q_ = q1;
+    p_ = p1;
+    lambda_ = lambda;
+    return s;
+  }
+
+  // Point k: q_k, v_k = V(q_k, p_k), p_k, the multiplier and the averaged
+  // constraint omega(qbar) gradbar_p H of the step that arrived at k (0 at k = 0).
+  void sample(Sample<n, m>* s) const {
+    s->has_p = true;
+    s->q = q_;
+    s->v = velocity<S, double>(sys_, q_, p_);
+    s->p = p_;
+    s->lambda = lambda_;
+    s->discrete_constraint = wd_;
+  }
+
+  Vec<double, 2 * n> phase() const {
+    Vec<double, 2 * n> z;
+    z << q_, p_;
+    return z;
+  }
+
+ private:
+  S sys_;
+  SolverOptions options_;
+  VecN q_ = VecN::Zero(), p_ = VecN::Zero();
+  VecM lambda_ = VecM::Zero(), wd_ = VecM::Zero();
+  long steps_ = 0;
+};
+
+// The method table's entry (methods.hpp): "discrete_gradient", symmetric, so composable.
+struct DiscreteGradientMethod {
+  static constexpr const char* name = "discrete_gradient";
+  static constexpr bool uses_discretization = false;
+  static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
+  static constexpr bool reports_p = true;
+  template <class S, class F>
+  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
+    SolverOptions opt;
+    opt.tolerance = spec.tolerance;
+    return with_composition(DiscreteGradientStepper<S>(sys, opt), spec.composition, f);
+  }
+  static std::vector<StudyEntry> study_entries() {
+    return {{spec_of(name)},
+            {spec_of(name, "triple_jump")},
+            {spec_of(name, "suzuki5"), "variant"},
+            {spec_of(name, "order6"), "variant"}};
+  }
+};
+
+}  // namespace nhi

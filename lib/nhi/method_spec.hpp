@@ -1,0 +1,49 @@
+// A method as a scene or a study names it (MethodSpec), and the entries a method
+// contributes to the studies (StudyEntry).  Kept apart from methods.hpp so that
+// each method's header can declare its own table entry (see methods.hpp).
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace nhi {
+
+struct MethodSpec {
+  std::string kind = "dla";              // a Methods name: "dla", "rk4", "benchmark", "mp06", ...
+  std::string discretization = "alpha";  // DLA: "alpha" or "symmetric"
+  double alpha = 0.5;
+  double tolerance = 1e-12;  // implicit methods: relative residual; the reference: CVODE rtol = atol
+  std::string composition = "none";  // symmetric methods: composition.hpp
+
+  // The one label scheme: "dla a=0.5", "dla-sym a=0", "rk4", "reference",
+  // "mp06", "mp06+triple_jump", "discrete_gradient+order6", "dla a=0.5+triple_jump".
+  std::string label() const {
+    char buf[96];
+    if (kind == "dla")
+      std::snprintf(buf, sizeof buf, "%s a=%g", discretization == "alpha" ? "dla" : "dla-sym", alpha);
+    else if (kind == "benchmark")
+      std::snprintf(buf, sizeof buf, "reference");
+    else
+      std::snprintf(buf, sizeof buf, "%s", kind.c_str());
+    return composition == "none" ? std::string(buf) : std::string(buf) + "+" + composition;
+  }
+};
+
+// A method's entry in the studies: "main" methods are in every study;
+// "variant"s (the paper's other alphas, ...) in those that sweep them.
+struct StudyEntry {
+  MethodSpec spec;
+  std::string group = "main";
+};
+
+// A spec with only its kind and composition set.
+inline MethodSpec spec_of(std::string kind, std::string composition = "none") {
+  MethodSpec s;
+  s.kind = std::move(kind);
+  s.composition = std::move(composition);
+  return s;
+}
+
+}  // namespace nhi

@@ -1,0 +1,278 @@
+// McLachlan & Perlmutter's reversible nonholonomic integrator ("Integrators for
+// nonholonomic mechanical systems", J. Nonlinear Sci. 16, 2006, eq. 4.18): a
+// RATTLE-type method on (q, p) that holds the velocity constraint exactly at
+// the grid points.  One step (q0, p0) -> (q1, p1) with multipliers lambda:
+//     q_half = q0 + (h/2) V(q0, p0)
+//     p1     = p0 + (h/2) [F(q_half, p0) + F(q_half, p1)] + h omega(q_half)^T lambda
+//     q1     = q_half + (h/2) V(q1, p1)
+//     omega(q1) V(q1, p1) = 0
+// with V, F from hamiltonian.hpp.  Symmetric (the step of -h from (q1, p1)
+// returns to (q0, p0): the adjoint exchanges the two half steps, and the
+// multiplier of the reverse step is the same lambda) and of order 2.
+//
+// Two forms of the same solve (NewtonSolver, solver.hpp):
+//  - general: unknowns y = (q1, p1), multipliers lambda; the constraint force
+//    h omega(q_half)^T lambda has fixed rows during the step (q_half is explicit),
+//    which is the saddle-point form the solver exploits;
+//  - separable systems (L = 1/2 v^T M v - U(q), M constant): F does not depend
+//    on p and V not on q, so p1 and q1 are explicit, affine in lambda, and the
+//    step is m equations omega(q1(lambda)) V(p1(lambda)) = 0 in lambda alone.
+// tests/test_new_methods.cpp checks that both forms give the same step, and
+// both against a closed-form step of the particle.
+#pragma once
+
+#include <string>
+
+#include "nhi/composition.hpp"
+#include "nhi/hamiltonian.hpp"
+#include "nhi/method_spec.hpp"
+#include "nhi/solver.hpp"
+
+namespace nhi {
+
+// General form: y = (q1, p1), lambda; rows (q equation, p equation, constraint).
+template <class S>
+struct Mp06Problem {
+  static constexpr int n = S::n, m = S::m;
+  static constexpr int ny = 2 * n, nl = m;
+  using VecN = Vec<double, n>;
+
+  const S& sys;
+  double h;
+  VecN p0, q_half, F0;     // F0 = F(q_half, p0)
+  Mat<double, ny, nl> W_t; // [0; h omega(q_half)^T]
+
+  Mp06Problem(const S& s, double hh, const VecN& q0, const VecN& p) : sys(s), h(hh), p0(p) {
+    q_half = q0 + 0.5 * h * velocity<S, double>(sys, q0, p0);
+    F0 = force<S, double>(sys, q_half, p0);
+    W_t.setZero();
+    W_t.template bottomRows<n>() = h * sys.template omega<double>(q_half).transpose();
+  }
+
+  const Mat<double, ny, nl>& Wt() const { return W_t; }
+
+  Vec<double, ny> y_scale(const Vec<double, ny>& y) const {
+    Vec<double, ny> s;
+    s << q_half.cwiseAbs() + y.template head<n>().cwiseAbs(), p0.cwiseAbs() + y.template tail<n>().cwiseAbs();
+    return s;
+  }
+
+  template <class T>
+  void residual(const Vec<T, ny>& y, const Vec<T, nl>& lambda, Vec<T, ny + nl>* r,
+                Vec<double, ny + nl>* terms) const {
+    const Vec<T, n> q1 = y.template head<n>(), p1 = y.template tail<n>();
+    const Vec<T, n> v1 = velocity(sys, q1, p1);
+    const Vec<T, n> F1 = force(sys, Vec<T, n>(q_half.template cast<T>()), p1);
+    const Mat<T, m, n> W1 = sys.template omega<T>(q1);
+    for (int i = 0; i < n; ++i) {
+      (*r)[i] = q1[i] - cst<T>(q_half[i]) - cst<T>(0.5 * h) * v1[i];  // q1 = q_half + (h/2) V(q1, p1)
+      T fc = cst<T>(0.0);
+      double fscale = 0;
+      for (int a = 0; a < m; ++a) {
+        fc += cst<T>(W_t(n + i, a)) * lambda[a];
+        fscale += std::abs(W_t(n + i, a) * value_of(lambda[a]));
+      }
+      // p1 = p0 + (h/2)(F(q_half, p0) + F(q_half, p1)) + h omega(q_half)^T lambda
+      (*r)[n + i] = p1[i] - cst<T>(p0[i]) - cst<T>(0.5 * h) * (cst<T>(F0[i]) + F1[i]) - fc;
+      if (terms) {
+        (*terms)[i] = std::abs(value_of(q1[i])) + std::abs(q_half[i]) + std::abs(0.5 * h * value_of(v1[i]));
+        (*terms)[n + i] = std::abs(value_of(p1[i])) + std::abs(p0[i]) +
+                          std::abs(0.5 * h) * (std::abs(F0[i]) + std::abs(value_of(F1[i]))) + fscale;
+      }
+    }
+    for (int a = 0; a < m; ++a) {  // omega(q1) V(q1, p1) = 0
+      T c = cst<T>(0.0);
+      double cs = 0;
+      for (int j = 0; j < n; ++j) {
+        c += W1(a, j) * v1[j];
+        cs += std::abs(value_of(W1(a, j)) * value_of(v1[j]));
+      }
+      (*r)[ny + a] = c;
+      if (terms) (*terms)[ny + a] = cs;
+    }
+  }
+
+  // q1, p1 from the solution.
+  void finish(const Vec<double, ny>& y, const Vec<double, nl>&, VecN* q1, VecN* p1) const {
+    *q1 = y.template head<n>();
+    *p1 = y.template tail<n>();
+  }
+  Vec<double, ny> guess(const VecN& q0, const Vec<double, nl>& lambda) const {
+    Vec<double, ny> y;
+    const VecN p1 = p0 + h * F0 + W_t.template bottomRows<n>() * lambda;
+    y << q_half + 0.5 * h * velocity<S, double>(sys, q_half, p1), p1;
+    (void)q0;
+    return y;
+  }
+};
+
+// Separable form: y = lambda (m unknowns), no saddle part.
+template <class S>
+struct Mp06SeparableProblem {
+  static constexpr int n = S::n, m = S::m;
+  static constexpr int ny = m, nl = 0;
+  using VecN = Vec<double, n>;
+
+  const S& sys;
+  double h;
+  VecN q_half, p_base;         // p1 = p_base + h omega(q_half)^T lambda, p_base = p0 + h F(q_half)
+  Mat<double, n, m> hWt;       // h omega(q_half)^T
+  Mat<double, ny, nl> W_t;     // empty
+
+  Mp06SeparableProblem(const S& s, double hh, const VecN& q0, const VecN& p0) : sys(s), h(hh) {
+    q_half = q0 + 0.5 * h * velocity<S, double>(sys, q0, p0);
+    // F(q_half, p) does not depend on p here, so (h/2)(F(q_half, p0) + F(q_half, p1)) = h F(q_half, p0).
+    p_base = p0 + h * force<S, double>(sys, q_half, p0);
+    hWt = h * sys.template omega<double>(q_half).transpose();
+  }
+
+  const Mat<double, ny, nl>& Wt() const { return W_t; }
+  Vec<double, ny> y_scale(const Vec<double, ny>& lambda) const { return lambda.cwiseAbs(); }
+
+  template <class T>
+  void state(const Vec<T, m>& lambda, Vec<T, n>* q1, Vec<T, n>* p1, Vec<T, n>* v1) const {
+    *p1 = p_base.template cast<T>() + hWt.template cast<T>() * lambda;
+    *v1 = velocity(sys, Vec<T, n>(q_half.template cast<T>()), *p1);  // V does not depend on q
+    *q1 = q_half.template cast<T>() + cst<T>(0.5 * h) * *v1;
+  }
+
+  template <class T>
+  void residual(const Vec<T, ny>& lambda, const Vec<T, nl>&, Vec<T, ny + nl>* r, Vec<double, ny + nl>* terms) const {
+    Vec<T, n> q1, p1, v1;
+    state(lambda, &q1, &p1, &v1);
+    const Mat<T, m, n> W1 = sys.template omega<T>(q1);
+    for (int a = 0; a < m; ++a) {  // omega(q1) V(q1, p1) = 0
+      T c = cst<T>(0.0);
+      double cs = 0;
+      for (int j = 0; j < n; ++j) {
+        c += W1(a, j) * v1[j];
+        cs += std::abs(value_of(W1(a, j)) * value_of(v1[j]));
+      }
+      (*r)[a] = c;
+      if (terms) (*terms)[a] = cs;
+    }
+  }
+};
+
+// The stateful mp06 stepper (stepper.hpp), lag 0.  kSeparable selects the
+// reduced solve (default: when the system declares it separable).
+template <class S, bool kSeparable = is_separable<S>::value>
+class Mp06Stepper {
+ public:
+  static constexpr int n = S::n, m = S::m;
+  static constexpr int lag = 0;
+  using VecN = Vec<double, n>;
+  using VecM = Vec<double, m>;
+
+  explicit Mp06Stepper(const S& sys, SolverOptions options = {}) : sys_(sys), options_(options) {}
+  const S& system() const { return sys_; }
+
+  MethodTraits traits() const {
+    MethodTraits t;
+    t.order = 2;
+    t.symmetric = true;
+    t.symmetric_in_phase = true;
+    t.holds_velocity_constraint = true;
+    t.implicit = true;
+    return t;
+  }
+
+  // Start from p0 = dL/dqdot(q0, v0).
+  void start(const VecN& q0, const VecN& v0) {
+    q_ = q0;
+    p_ = momentum(sys_, q0, v0);
+    lambda_ = VecM::Zero();
+    steps_ = 0;
+  }
+
+  // One step (q0, p0) -> (q1, p1) of size h; lambda holds the starting guess and gets the multiplier.
+  StepSummary map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecM* lambda) const {
+    StepSummary s;
+    if constexpr (kSeparable) {
+      const Mp06SeparableProblem<S> prob(sys_, h, q0, p0);
+      VecM y = *lambda;
+      Vec<double, 0> none;
+      s = NewtonSolver<Mp06SeparableProblem<S>>(prob, options_).solve(&y, &none);
+      if (s.ok()) {
+        VecN v1;
+        prob.state(y, q1, p1, &v1);
+        *lambda = y;
+      }
+    } else {
+      const Mp06Problem<S> prob(sys_, h, q0, p0);
+      Vec<double, 2 * n> y = prob.guess(q0, *lambda);
+      VecM l = *lambda;
+      s = NewtonSolver<Mp06Problem<S>>(prob, options_).solve(&y, &l);
+      if (s.ok()) {
+        prob.finish(y, l, q1, p1);
+        *lambda = l;
+      }
+    }
+    return s;
+  }
+
+  StepSummary step(double h) {
+    VecN q1, p1;
+    VecM lambda = lambda_;
+    StepSummary s = map(h, q_, p_, &q1, &p1, &lambda);
+    ++steps_;
+    if (s.ok() && !(q1.allFinite() && p1.allFinite())) {
+      s.status = SolveStatus::kFailed;
+      s.failure = FailureKind::kNonFinite;
+      s.message = "non-finite state";
+    }
+    if (!s.ok()) {
+      s.message = "mp06 step " + std::to_string(steps_) + " did not converge: " + s.message;
+      return s;
+    }
+    q_ = q1;
+    p_ = p1;
+    lambda_ = lambda;
+    return s;
+  }
+
+  // Point k: q_k, v_k = V(q_k, p_k) (omega(q_k) v_k = 0 to round-off), p_k, the
+  // multiplier of the step that arrived at k (0 at k = 0), and omega(q_k) v_k
+  // as the constraint the method holds.
+  void sample(Sample<n, m>* s) const {
+    s->has_p = true;
+    s->q = q_;
+    s->v = velocity<S, double>(sys_, q_, p_);
+    s->p = p_;
+    s->lambda = lambda_;
+    s->discrete_constraint = sys_.template omega<double>(q_) * s->v;
+  }
+
+  Vec<double, 2 * n> phase() const {
+    Vec<double, 2 * n> z;
+    z << q_, p_;
+    return z;
+  }
+  const VecM& lambda() const { return lambda_; }
+
+ private:
+  S sys_;
+  SolverOptions options_;
+  VecN q_ = VecN::Zero(), p_ = VecN::Zero();
+  VecM lambda_ = VecM::Zero();
+  long steps_ = 0;
+};
+
+// The method table's entry (methods.hpp): "mp06", symmetric, so composable.
+struct Mp06Method {
+  static constexpr const char* name = "mp06";
+  static constexpr bool uses_discretization = false;
+  static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
+  static constexpr bool reports_p = true;
+  template <class S, class F>
+  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
+    SolverOptions opt;
+    opt.tolerance = spec.tolerance;
+    return with_composition(Mp06Stepper<S>(sys, opt), spec.composition, f);
+  }
+  static std::vector<StudyEntry> study_entries() {
+    return {{spec_of(name)}, {spec_of(name, "triple_jump")}, {spec_of(name, "suzuki5")}, {spec_of(name, "order6")}};
+  }
+};
+
+}  // namespace nhi

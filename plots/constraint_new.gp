@@ -1,0 +1,30 @@
+# Companion to Figures 2 and 4 (issue 11): |omega_a(q) v| along the paper's
+# DLA (central-difference velocities), mp06 and its triple jump (v_k = V(q_k, p_k),
+# which they keep in the constraint distribution), RK4 and the reference
+# solution, h = 0.2, log scale.  Exact zeros are not drawn.  Called as
+# plots/constraint.gp (stem, out, label, m).
+load "plots/style.gp"
+set output out
+dla = stem."_dla.json"
+mp = stem."_mp06.json"
+mptj = stem."_mp06tj.json"
+rk4 = stem."_rk4.json"
+ref = stem."_benchmark.json"
+set terminal pngcairo size 1000,(400 * m)
+set multiplot layout m,1 title label.", constraint values (h = 0.2), methods after the paper"
+set xlabel "t"
+set logscale y
+set format y "10^{%L}"
+set yrange [1e-19:10]
+set key tmargin center horizontal maxrows 2 noopaque nobox
+do for [a = 0:m-1] {
+  set title sprintf("|{/Symbol w}_%d(q) v|, whole run (log scale)", a + 1)
+  set ylabel sprintf("|{/Symbol w}_%d(q) v|", a + 1)
+  f = sprintf(".constraint | map(.[%d] | fabs)", a)
+  plot col(dla, f) u 1:2 w l ls 11 t "DLA, {/Symbol a} = 1/2", \
+       col(rk4, f) u 1:2 w l ls 14 t "RK4", \
+       col(ref, f) u 1:2 w l ls 15 t "reference", \
+       col(mp, f) u 1:2 w p pt 7 ps 0.3 lc rgb "#ff7f0e" t "mp06", \
+       col(mptj, f) u 1:2 w p pt 5 ps 0.3 lc rgb "#a63603" t "mp06, triple jump"
+}
+unset multiplot

@@ -1,0 +1,230 @@
+// The methods after the paper (issue 11), each against an independent
+// derivation: mp06 against a closed-form particle step and its general form
+// against its reduced (separable) form; the discrete gradient against the
+// constrained implicit midpoint rule that it reduces to for a quadratic
+// energy (the particle), and its defining identity on a non-quadratic one (the
+// robot); the generic inverse Legendre map against the hand-written ones; the
+// composition coefficients against their order conditions; and the failure
+// path (no convergence, non-finite state) shared with the DLA.  Orders,
+// reversibility and bounded energies are in the typed contract suite
+// (test_methods.cpp), which runs these methods like every other.
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+
+#include "scenes.hpp"
+
+namespace nhi::test {
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+template <class S>
+class NewMethodsTest : public ::testing::Test {};
+TYPED_TEST_SUITE(NewMethodsTest, Systems);
+
+// The hand-written V(q, p) (the fast path) against the generic one from the
+// partials, with random parameters, and p -> V -> p round trips.
+TYPED_TEST(NewMethodsTest, InverseLegendreMapIsTheGenericOne) {
+  using S = TypeParam;
+  constexpr int n = S::n;
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int trial = 0; trial < 10; ++trial) {
+    const S sys = randomized_system<S>(rng);
+    Vec<double, n> q, p;
+    for (int i = 0; i < n; ++i) {
+      q[i] = u(rng);
+      p[i] = u(rng);
+    }
+    const Vec<double, n> v = velocity<S, double>(sys, q, p), vg = generic_velocity<S, double>(sys, q, p);
+    EXPECT_LE((v - vg).cwiseAbs().maxCoeff(), 16 * kEps * (1 + v.cwiseAbs().maxCoeff()));
+    EXPECT_LE((momentum(sys, q, v) - p).cwiseAbs().maxCoeff(), 16 * kEps * (1 + p.cwiseAbs().maxCoeff()));
+    const double H = hamiltonian<S, double>(sys, q, p);
+    EXPECT_NEAR(H, energy(sys, q, v), 16 * kEps * (1 + p.squaredNorm()));
+  }
+}
+
+// mp06's general form (unknowns q1, p1, lambda) and its reduced form (lambda
+// only, for separable systems) are the same map: 50 steps agree to round-off.
+TYPED_TEST(NewMethodsTest, Mp06GeneralAndSeparableFormsAgree) {
+  using S = TypeParam;
+  static_assert(is_separable<S>::value, "the paper's scenes are separable");
+  const S sys = make_system<S>();
+  Mp06Stepper<S, true> fast(sys);
+  Mp06Stepper<S, false> full(sys);
+  fast.start(S::default_q0(), S::default_v0());
+  full.start(S::default_q0(), S::default_v0());
+  for (int k = 0; k < 50; ++k) {
+    ASSERT_TRUE(fast.step(0.2).ok());
+    ASSERT_TRUE(full.step(0.2).ok());
+  }
+  const auto z1 = fast.phase(), z2 = full.phase();
+  EXPECT_LE((z1 - z2).cwiseAbs().maxCoeff(), 1e-12 * (1 + z1.cwiseAbs().maxCoeff()));
+  EXPECT_LE((fast.lambda() - full.lambda()).cwiseAbs().maxCoeff(), 1e-11 * (1 + fast.lambda().cwiseAbs().maxCoeff()));
+}
+
+// mp06 on the particle in closed form (McLachlan & Perlmutter eq. 4.18 with
+// V = p, F = (-2 kx x, -2 ky y, 0), omega = (-y, 0, 1)): the y row of the
+// constraint force is zero, so y1 is explicit and the constraint
+// -y1 p1x + p1z = 0 is linear in lambda:
+//   lambda = (y1 pb_x - pb_z) / (h (1 + y1 y_half)),  pb = p0 + h F(q_half).
+TEST(Mp06, ParticleStepIsTheClosedForm) {
+  std::mt19937 rng(5);
+  const Particle sys = randomized_system<Particle>(rng);
+  Vec<double, 3> q0, v0;
+  random_state<Particle>(rng, &q0, &v0, sys);
+  for (double h : {0.2, -0.13, 1e-6}) {
+    const Vec<double, 3> p0 = v0;
+    const Vec<double, 3> qh = q0 + 0.5 * h * p0;
+    const Vec<double, 3> F(-2 * sys.kx * qh[0], -2 * sys.ky * qh[1], 0.0);
+    const Vec<double, 3> pb = p0 + h * F;
+    const double y1 = qh[1] + 0.5 * h * pb[1];
+    const double lambda = (y1 * pb[0] - pb[2]) / (h * (1 + y1 * qh[1]));
+    const Vec<double, 3> p1 = pb + h * lambda * Vec<double, 3>(-qh[1], 0.0, 1.0);
+    const Vec<double, 3> q1 = qh + 0.5 * h * p1;
+
+    Mp06Stepper<Particle> st(sys);
+    st.start(q0, v0);
+    ASSERT_TRUE(st.step(h).ok());
+    const Vec<double, 6> z = st.phase();
+    EXPECT_LE((z.head<3>() - q1).cwiseAbs().maxCoeff(), 64 * kEps * (1 + q1.cwiseAbs().maxCoeff())) << h;
+    EXPECT_LE((z.tail<3>() - p1).cwiseAbs().maxCoeff(), 64 * kEps * (1 + p1.cwiseAbs().maxCoeff())) << h;
+    EXPECT_NEAR(st.lambda()[0], lambda, 1e-12 * (1 + std::abs(lambda))) << h;
+    EXPECT_LE(std::abs(-q1[1] * p1[0] + p1[2]), 16 * kEps * (1 + p1.cwiseAbs().maxCoeff()));  // held at q1
+  }
+}
+
+// The discrete gradient on the particle: H = |p|^2/2 + kx x^2 + ky y^2 is
+// quadratic, so Gonzalez's correction vanishes and the scheme is the implicit
+// midpoint rule with the constraint at the midpoint.  The y equations do not
+// see the constraint force (omega has no y entry): a 2x2 linear solve for
+// (y1, p_y1); then omega(qbar) = (-ybar, 0, 1) is known and the rest is a 5x5
+// linear system in (x1, z1, p_x1, p_z1, lambda).
+TEST(DiscreteGradient, ParticleStepIsTheConstrainedMidpointRule) {
+  std::mt19937 rng(6);
+  const Particle sys = randomized_system<Particle>(rng);
+  Vec<double, 3> q0, v0;
+  random_state<Particle>(rng, &q0, &v0, sys);
+  const Vec<double, 3> p0 = v0;
+  for (double h : {0.2, -0.31}) {
+    // y1 = y0 + h (py0 + py1)/2,  py1 = py0 - 2 ky h (y0 + y1)/2
+    Eigen::Matrix2d A;
+    A << 1, -h / 2, sys.ky * h, 1;
+    const Eigen::Vector2d b(q0[1] + h / 2 * p0[1], p0[1] - sys.ky * h * q0[1]);
+    const Eigen::Vector2d y = A.fullPivLu().solve(b);
+    const double yb = 0.5 * (q0[1] + y[0]);
+    // unknowns (x1, z1, px1, pz1, lambda)
+    Eigen::Matrix<double, 5, 5> K;
+    Eigen::Matrix<double, 5, 1> c;
+    K << 1, 0, -h / 2, 0, 0,  //  x1 - h px1/2            = x0 + h px0/2
+        0, 1, 0, -h / 2, 0,   //  z1 - h pz1/2            = z0 + h pz0/2
+        sys.kx * h, 0, 1, 0, h * yb,  //  px1 + kx h x1 + h ybar lambda = px0 - kx h x0
+        0, 0, 0, 1, -h,       //  pz1 - h lambda          = pz0
+        0, 0, -yb / 2, 0.5, 0;  // -ybar (px0 + px1)/2 + (pz0 + pz1)/2 = 0
+    c << q0[0] + h / 2 * p0[0], q0[2] + h / 2 * p0[2], p0[0] - sys.kx * h * q0[0], p0[2],
+        yb / 2 * p0[0] - 0.5 * p0[2];
+    const Eigen::Matrix<double, 5, 1> x = K.fullPivLu().solve(c);
+    const Vec<double, 3> q1(x[0], y[0], x[1]), p1(x[2], y[1], x[3]);
+
+    DiscreteGradientStepper<Particle> st(sys);
+    st.start(q0, v0);
+    ASSERT_TRUE(st.step(h).ok());
+    const Vec<double, 6> z = st.phase();
+    EXPECT_LE((z.head<3>() - q1).cwiseAbs().maxCoeff(), 1e-13 * (1 + q1.cwiseAbs().maxCoeff())) << h;
+    EXPECT_LE((z.tail<3>() - p1).cwiseAbs().maxCoeff(), 1e-13 * (1 + p1.cwiseAbs().maxCoeff())) << h;
+  }
+}
+
+// Gonzalez's discrete gradient satisfies H(z1) - H(z0) = gradbar H . (z1 - z0)
+// (its defining property) and tends to grad H as z1 -> z0, on a
+// non-quadratic H (the robot's potential V0 sin psi).
+TEST(DiscreteGradient, DefiningIdentityOnANonQuadraticEnergy) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  const Robot sys = randomized_system<Robot>(rng);
+  for (int trial = 0; trial < 10; ++trial) {
+    Vec<double, 4> q0, p0, q1, p1;
+    for (int i = 0; i < 4; ++i) {
+      q0[i] = u(rng);
+      p0[i] = u(rng);
+      q1[i] = q0[i] + 0.3 * u(rng);
+      p1[i] = p0[i] + 0.3 * u(rng);
+    }
+    const DiscreteGradientProblem<Robot> prob(sys, 0.2, q0, p0);
+    Vec<double, 4> Dq, Dp;
+    prob.discrete_gradient<double>(q1, p1, &Dq, &Dp);
+    const double dH = hamiltonian<Robot, double>(sys, q1, p1) - hamiltonian<Robot, double>(sys, q0, p0);
+    EXPECT_NEAR(dH, Dq.dot(q1 - q0) + Dp.dot(p1 - p0), 1e-14 * (1 + p0.squaredNorm() + sys.V0));
+    // Close to the gradient at the midpoint for a short chord: (-F, V) at zbar.
+    const Vec<double, 4> q2 = q0 + 1e-4 * (q1 - q0), p2 = p0 + 1e-4 * (p1 - p0);
+    prob.discrete_gradient<double>(q2, p2, &Dq, &Dp);
+    const Vec<double, 4> qb = 0.5 * (q0 + q2), pb = 0.5 * (p0 + p2);
+    EXPECT_LE((Dq + force<Robot, double>(sys, qb, pb)).cwiseAbs().maxCoeff(), 1e-6 * (1 + sys.V0));
+    EXPECT_LE((Dp - velocity<Robot, double>(sys, qb, pb)).cwiseAbs().maxCoeff(), 1e-6);
+  }
+}
+
+// The composition coefficients satisfy the order conditions of a symmetric
+// composition of a symmetric method (HLW II.4, V.3): sum gamma = 1, the
+// coefficients are palindromic, sum gamma^3 = 0 for order 4, and in addition
+// sum gamma^5 = 0 for order 6.  (Order 6 has one more condition; the fitted
+// order in test_methods.cpp is the check of the whole.)
+TEST(Composition, CoefficientsSatisfyTheOrderConditions) {
+  for (const Composition& c : compositions()) {
+    double s1 = 0, s3 = 0, s5 = 0;
+    const size_t s = c.gamma.size();
+    for (size_t i = 0; i < s; ++i) {
+      s1 += c.gamma[i];
+      s3 += std::pow(c.gamma[i], 3);
+      s5 += std::pow(c.gamma[i], 5);
+      EXPECT_EQ(c.gamma[i], c.gamma[s - 1 - i]) << c.name;
+    }
+    EXPECT_NEAR(s1, 1.0, 4 * kEps) << c.name;
+    if (c.order >= 4) {
+      EXPECT_NEAR(s3, 0.0, 1e-15) << c.name;
+    }
+    if (c.order >= 6) {
+      EXPECT_NEAR(s5, 0.0, 1e-15) << c.name;
+    }
+  }
+  EXPECT_THROW(composition("order8"), std::invalid_argument);
+}
+
+// The shared failure path: a solve that cannot reach its tolerance and a
+// non-finite start end the run with status failed and the right kind, at the
+// first step, with the points before it kept; a tiny step works.
+TYPED_TEST(NewMethodsTest, FailuresGoThroughTheSharedPath) {
+  using S = TypeParam;
+  const S sys = make_system<S>();
+  for (const char* kind : {"mp06", "discrete_gradient"}) {
+    for (const char* comp : {"none", "triple_jump"}) {
+      MethodSpec spec = spec_of(kind, comp);
+      long seen = 0;
+      auto count = [&](const Sample<S::n, S::m>&) { return ++seen, true; };
+      spec.tolerance = 1e-300;  // unreachable: Newton and the fallback both fail
+      RunReport rep = run_method(sys, spec, S::default_q0(), S::default_v0(), 0.2, 10, count);
+      EXPECT_FALSE(rep.ok) << spec.label();
+      EXPECT_EQ(rep.failure, FailureKind::kSolve) << spec.label() << ": " << rep.reason;
+      EXPECT_EQ(rep.failure_step, 1) << spec.label();
+      EXPECT_EQ(seen, 1) << spec.label();
+      EXPECT_NE(rep.reason.find(kind), std::string::npos) << rep.reason;
+
+      spec.tolerance = 1e-12;
+      Vec<double, S::n> q0 = S::default_q0();
+      q0[0] = std::numeric_limits<double>::quiet_NaN();
+      seen = 0;
+      rep = run_method(sys, spec, q0, S::default_v0(), 0.2, 10, count);
+      EXPECT_FALSE(rep.ok) << spec.label();
+      EXPECT_EQ(rep.failure, FailureKind::kNonFinite) << spec.label() << ": " << rep.reason;
+
+      seen = 0;
+      rep = run_method(sys, spec, S::default_q0(), S::default_v0(), 1e-9, 10, count);
+      EXPECT_TRUE(rep.ok) << spec.label() << " tiny step: " << rep.reason;
+      EXPECT_EQ(seen, 11);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace nhi::test
