@@ -67,8 +67,9 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
   for (const StudyMethod& m : fixed_step_methods()) {
     const int p = method_traits(sys, m.spec).order;
     std::vector<double> hs, eq, ev, eE;
-    // Order 6 reaches the floor 1e-10 by h ~ 0.01: start it at 0.4 for enough points above it.
-    for (double h = p >= 6 ? 0.4 : 0.1; h > 0.003; h /= 2) {
+    // Order 6 reaches the floor 1e-10 by h ~ 0.02: start it at 0.2 for enough
+    // points above it (at 0.4 the 9-stage robot run is not yet asymptotic).
+    for (double h = p >= 6 ? 0.2 : 0.1; h > 0.003; h /= 2) {
       const Final<S> f = run_to_end(sys, m.spec, q0, v0, h, std::lround(T / h));
       ASSERT_TRUE(f.rep.ok) << m.label() << ": " << f.rep.reason;
       hs.push_back(h);
@@ -79,15 +80,19 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
     const double tol = p >= 4 ? 0.2 : (p == 2 ? 0.1 : 0.15);  // as test_convergence always had
     const OrderFit fq = fit_order(hs, eq, 1e-10), fv = fit_order(hs, ev, 1e-10), fE = fit_order(hs, eE, 1e-10);
     ASSERT_TRUE(fq.order && fv.order) << m.label() << ": too few points above the floor";
-    std::printf("    %-14s declared %d, fitted q %.3f, v %.3f, energy %s\n", m.label().c_str(), p, *fq.order,
+    std::printf("    %-14s declared %d, fitted q %.3f, v %.3f, energy %s; q errors", m.label().c_str(), p, *fq.order,
                 *fv.order, fE.order ? std::to_string(*fE.order).c_str() : "-");
+    for (double e : eq) std::printf(" %.2e", e);
+    std::printf("\n");
     EXPECT_NEAR(*fq.order, p, tol) << m.label() << " (q)";
     // The reported velocity and the energy error are at least of the declared
     // order (higher is possible: RK4's v on the robot fits 5.2 over these h, its
     // energy error at T = 4 is partly below the floor and pre-asymptotic, so it
     // is not fitted; a first-order velocity formula in a second-order method fails).
-    EXPECT_GT(*fv.order, p - tol) << m.label() << " (the reported velocity)";
-    if (p <= 2 && !method_traits(sys, m.spec).preserves_energy) {  // (an energy-preserving method's is round-off)
+    const MethodTraits t = method_traits(sys, m.spec);
+    const int pv = t.velocity_order ? t.velocity_order : p;
+    EXPECT_GT(*fv.order, pv - tol) << m.label() << " (the reported velocity, declared order " << pv << ")";
+    if (p <= 2 && !t.preserves_energy) {  // (an energy-preserving method's is round-off)
       ASSERT_TRUE(fE.order) << m.label();
       EXPECT_GT(*fE.order, p - tol) << m.label() << " (energy)";
     }
@@ -121,9 +126,10 @@ TYPED_TEST(MethodContract, SymmetricMethodsAreReversibleAndOthersAreNot) {
           const double dq = (z2.template head<n>() - z0.template head<n>()).cwiseAbs().maxCoeff() / scale;
           const double dz = (z2 - z0).cwiseAbs().maxCoeff() / scale;
           if (t.symmetric) {
-            EXPECT_LE(dq, 64 * kEps) << m.label() << " h " << h;
+            // 64 eps per one-step solve: a composition's stages each add their round-off.
+            EXPECT_LE(dq, 64 * kEps * t.stages) << m.label() << " h " << h;
             if (t.symmetric_in_phase) {
-              EXPECT_LE(dz, 64 * kEps) << m.label() << " h " << h;
+              EXPECT_LE(dz, 64 * kEps * t.stages) << m.label() << " h " << h;
             }
           } else {
             EXPECT_GT(dq, 1e-9) << m.label() << " h " << h << ": a non-symmetric method returned";

@@ -51,21 +51,37 @@ struct DiscreteGradientProblem {
     return s;
   }
 
-  // gradbar H(z0, z1) as (gradbar_q, gradbar_p).
+  // gradbar H(z0, z1) as (gradbar_q, gradbar_p).  With sq, sp (may be null):
+  // per component the size of what it adds up, |grad H(zbar)| + |c dz| with c
+  // taken at the size of its numerator's terms, |H1| + |H0| + |grad H . dz|
+  // (over |dz|^2): the correction's rounding, which sets the floor of every
+  // row that contains it (when the velocities in a constraint row vanish
+  // together, it is all that is left of that row's size).
   template <class T>
-  void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp) const {
+  void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp,
+                         VecN* sq = nullptr, VecN* sp = nullptr) const {
     const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1), pb = cst<T>(0.5) * (p0.template cast<T>() + p1);
     const Vec<T, n> gq = -force(sys, qb, pb), gp = velocity(sys, qb, pb);
     const Vec<T, n> dq = q1 - q0.template cast<T>(), dp = p1 - p0.template cast<T>();
     const T den = dq.squaredNorm() + dp.squaredNorm();
     *Dq = gq;
     *Dp = gp;
+    double cs = 0;
     if (value_of(den) > 0) {  // Gonzalez's correction along dz (eq. 3.6)
       const T H1 = hamiltonian(sys, q1, p1);
       const T c = (H1 - cst<T>(H0) - gq.dot(dq) - gp.dot(dp)) / den;
       *Dq += c * dq;
       *Dp += c * dp;
+      double num = std::abs(value_of(H1)) + std::abs(H0);
+      for (int i = 0; i < n; ++i)
+        num += std::abs(value_of(gq[i]) * value_of(dq[i])) + std::abs(value_of(gp[i]) * value_of(dp[i]));
+      cs = num / value_of(den);
     }
+    if (sq && sp)
+      for (int i = 0; i < n; ++i) {
+        (*sq)[i] = std::abs(value_of(gq[i])) + cs * std::abs(value_of(dq[i]));
+        (*sp)[i] = std::abs(value_of(gp[i])) + cs * std::abs(value_of(dp[i]));
+      }
   }
 
   template <class T>
@@ -73,7 +89,8 @@ struct DiscreteGradientProblem {
     const Vec<T, n> q1 = y.template head<n>(), p1 = y.template segment<n>(n);
     const Vec<T, m> lambda = y.template tail<m>();
     Vec<T, n> Dq, Dp;
-    discrete_gradient(q1, p1, &Dq, &Dp);
+    VecN sq, sp;
+    discrete_gradient(q1, p1, &Dq, &Dp, &sq, &sp);
     const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1);
     const Mat<T, m, n> Wb = sys.template omega<T>(qb);
     const Vec<T, n> fc = Wb.transpose() * lambda;
@@ -81,10 +98,10 @@ struct DiscreteGradientProblem {
       (*r)[i] = q1[i] - cst<T>(q0[i]) - cst<T>(h) * Dp[i];                        // (q1 - q0)/h = gradbar_p H
       (*r)[n + i] = p1[i] - cst<T>(p0[i]) + cst<T>(h) * (Dq[i] - fc[i]);          // (p1 - p0)/h = -gradbar_q H + omega^T lambda
       if (terms) {
-        (*terms)[i] = std::abs(value_of(q1[i])) + std::abs(q0[i]) + std::abs(h * value_of(Dp[i]));
+        (*terms)[i] = std::abs(value_of(q1[i])) + std::abs(q0[i]) + std::abs(h) * sp[i];
         double fs = 0;
         for (int a = 0; a < m; ++a) fs += std::abs(value_of(Wb(a, i)) * value_of(lambda[a]));
-        (*terms)[n + i] = std::abs(value_of(p1[i])) + std::abs(p0[i]) + std::abs(h) * (std::abs(value_of(Dq[i])) + fs);
+        (*terms)[n + i] = std::abs(value_of(p1[i])) + std::abs(p0[i]) + std::abs(h) * (sq[i] + fs);
       }
     }
     for (int a = 0; a < m; ++a) {  // omega(qbar) gradbar_p H = 0
@@ -92,7 +109,7 @@ struct DiscreteGradientProblem {
       double cs = 0;
       for (int j = 0; j < n; ++j) {
         c += Wb(a, j) * Dp[j];
-        cs += std::abs(value_of(Wb(a, j)) * value_of(Dp[j]));
+        cs += std::abs(value_of(Wb(a, j))) * sp[j];
       }
       (*r)[2 * n + a] = c;
       if (terms) (*terms)[2 * n + a] = cs;
@@ -138,9 +155,9 @@ class DiscreteGradientStepper {
     // Guess: an explicit Stoermer-Verlet-like step with the last multiplier
     // (second order when lambda is), so Newton starts close.
     const VecN qh = q0 + 0.5 * h * velocity<S, double>(sys_, q0, p0);
-    const VecN p1 = p0 + h * (force<S, double>(sys_, qh, p0) + sys_.template omega<double>(qh).transpose() * *lambda);
+    const VecN pg = p0 + h * (force<S, double>(sys_, qh, p0) + sys_.template omega<double>(qh).transpose() * *lambda);
     Vec<double, Problem::ny> y;
-    y << qh + 0.5 * h * velocity<S, double>(sys_, qh, p1), p1, *lambda;
+    y << qh + 0.5 * h * velocity<S, double>(sys_, qh, pg), pg, *lambda;
     Vec<double, 0> none;
     StepSummary s = NewtonSolver<Problem>(prob, options_).solve(&y, &none);
     if (s.ok()) {

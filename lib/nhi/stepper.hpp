@@ -64,6 +64,7 @@ struct StepSummary {
 // hard-coding expectations.
 struct MethodTraits {
   int order = 0;                  // global order of q on smooth problems
+  int velocity_order = 0;         // ... of the reported v (0: the same as order)
   bool symmetric = false;         // self-adjoint: a step of h then of -h returns to the start
   bool symmetric_in_phase = true; // ... in (q, p) or (q, v); false: in q only (the DLA, see dla.hpp)
   bool holds_velocity_constraint = false;  // omega(q_k) v_k = 0 at grid points to round-off
