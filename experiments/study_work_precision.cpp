@@ -116,13 +116,16 @@ int main(int argc, char** argv) {
   const auto external = study::methods([](const nhi::StudyMethod& m) { return m.external; });
   // h = 0.4 / 2^j down to j = 9 for second-order methods; order 4 stops at
   // j = 6 and order 6 at j = 5, where their errors reach the round-off floor
-  // (and a 9-stage step at h = 0.4/2^9 over T = 10^4 would cost minutes).
+  // (and a 9-stage step at h = 0.4/2^9 over T = 10^4 would cost minutes); an
+  // energy-preserving method (whose energy error is round-off at every h, and
+  // whose step costs ~10 mp06 steps) stops at j = 6 too.
   auto configs_for = [&](const auto& sys) {
     std::vector<Config> configs;
     for (int j = 0; j <= 9; ++j)
       for (const auto& m : fixed) {
-        const int order = nhi::method_traits(sys, m.spec).order;
-        if (j <= (order >= 6 ? 5 : order >= 4 ? 6 : 9)) configs.push_back({m, 0.4 / (1 << j)});
+        const nhi::MethodTraits t = nhi::method_traits(sys, m.spec);
+        const int jmax = t.order >= 6 ? 5 : (t.order >= 4 || t.preserves_energy) ? 6 : 9;
+        if (j <= jmax) configs.push_back({m, 0.4 / (1 << j)});
       }
     for (int e = 3; e <= 12; ++e)
       for (const auto& m : reference) configs.push_back({m, std::pow(10.0, -e)});
