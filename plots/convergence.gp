@@ -1,6 +1,7 @@
 # Study 1: global error at T against h, log-log, with reference slopes.
 # Called as gnuplot -e "file='results/convergence.json'; scene='particle'; out='plots/convergence_particle.png'" plots/convergence.gp
 load "plots/style.gp"
+set key noenhanced  # method labels contain underscores
 set terminal pngcairo size 1400,620 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 # Columns h, error of method i if its family is (want = 1) or is not (want = 0) "isolation".

@@ -2,7 +2,8 @@
 # log-log, so that bounded oscillation (flat) and drift (slope 1) separate.
 # Called as gnuplot -e "file='results/long_horizon.json'; scene='particle'; out='plots/long_horizon_particle.png'" plots/long_horizon.gp
 load "plots/style.gp"
-set terminal pngcairo size 1500,520 enhanced font "DejaVu Sans,10" linewidth 1.2
+set key noenhanced  # method labels contain underscores
+set terminal pngcairo size 1500,800 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 series(i, key, group) = sprintf("< jq -r '.scenes.%s.methods[%d] | select(.group == \"%s\") | [.t, .%s] | transpose[] | select(.[1] > 0) | @tsv' %s", scene, i, group, key, file)
 label(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label): \\(.fate)\"' %s", scene, i, file))
@@ -14,19 +15,18 @@ set logscale xy
 set format x "10^{%L}"
 set format y "10^{%L}"
 set xlabel "t"
-set key bottom right font ",8" spacing 0.9
+set key outside below font ",8" spacing 0.9 maxrows 6
 set xrange [0.2:3e5]
 set style data lines
 set multiplot layout 1,3 title sprintf("Long horizon, h = 0.2, T = 2x10^5 (%s)", scene)
 set title "max_{s <= t} |E - E_0|"
-set yrange [1e-12:1e3]
+set yrange [1e-17:1e3]
 plot for [i=0:N-1] series(i, "max_energy_error", "main") u 1:2 ls sty(i) t (group(i) eq "main" ? label(i) : "")
 set title "max_{s <= t} max_a |{/Symbol w}_a(q) v|"
-set yrange [1e-12:1e3]
+set yrange [1e-17:1e3]
 plot for [i=0:N-1] series(i, "max_constraint", "main") u 1:2 ls sty(i) t (group(i) eq "main" ? label(i) : "")
-set title "alpha != 1/2 variants: max_{s <= t} |E - E_0|"
-set yrange [1e-3:1e6]
-set key top left
+set title "variants (other alphas, more compositions): max_{s <= t} |E - E_0|"
+set yrange [1e-12:1e6]
 set format y "10^{%L}"
 plot for [i=0:N-1] series(i, "max_energy_error", "variant") u 1:2 ls sty(i) t (group(i) eq "variant" ? label(i) : "")
 unset multiplot

@@ -2,6 +2,7 @@
 # stable h per method.
 # Called as gnuplot -e "file='results/stability.json'; scene='particle'; out='plots/stability_particle.png'" plots/stability.gp
 load "plots/style.gp"
+set key noenhanced  # method labels contain underscores
 set terminal pngcairo size 1500,560 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 # Line style of method i: 10 + its fixed style (plots/style.gp).

@@ -2,6 +2,7 @@
 # error over T = 10^4, every method on the same axes.
 # Called as gnuplot -e "file='results/work_precision.json'; scene='particle'; out='plots/work_precision_particle.png'" plots/work_precision.gp
 load "plots/style.gp"
+set key noenhanced  # method labels contain underscores
 set terminal pngcairo size 1400,600 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 set datafile separator "\t"
