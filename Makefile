@@ -48,7 +48,7 @@ test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
 
 # The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer (its own
-# build tree, only the test targets; about 18 minutes to build on 2 cores).
+# build tree, only the test targets; about 60 minutes to build on 2 cores with the methods of issue 11; not in .ci/run).
 SANITIZE := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 test-sanitize: deps
 	cmake -S . -B $(BUILD)-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNHI_NATIVE=OFF \
