@@ -22,6 +22,7 @@
 
 #include "nhi/fit.hpp"
 #include "nhi/methods.hpp"
+#include "nhi/run.hpp"
 #include "nhi/output.hpp"
 #include "nhi/scene.hpp"
 #include "nhi/scene_detail.hpp"

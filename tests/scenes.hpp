@@ -9,6 +9,7 @@
 #include "nhi/fit.hpp"
 #include "nhi/integrate.hpp"
 #include "nhi/methods.hpp"
+#include "nhi/run.hpp"
 #include "nhi/systems/registry.hpp"
 
 namespace nhi::test {
@@ -17,6 +18,8 @@ namespace nhi::test {
 // those that declare the capability a suite needs.
 using Systems = nhi::Systems::apply<::testing::Types>;
 using ReversibleSystems = filter_t<is_reversible, nhi::Systems>::apply<::testing::Types>;
+using ReversibleIntegrableSystems = filter_t<is_reversible_integrable, nhi::Systems>::apply<::testing::Types>;
+using SeparableSystems = filter_t<is_separable, nhi::Systems>::apply<::testing::Types>;
 using ChaplyginSystems = filter_t<has_chaplygin_split, nhi::Systems>::apply<::testing::Types>;
 using PaperSystems = filter_t<is_paper_scene, nhi::Systems>::apply<::testing::Types>;
 using MomentumEquationSystems = filter_t<has_momentum_equation, nhi::Systems>::apply<::testing::Types>;

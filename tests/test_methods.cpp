@@ -6,8 +6,10 @@
 // round-off; bounded energy for symmetric methods on reversible scenes; the
 // implicit solves need no fallback; pinned numbers.  Adding a system or a
 // method adds it here.
+#include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 
 #include "scenes.hpp"
 
@@ -30,7 +32,7 @@ TYPED_TEST_SUITE(MethodContract, Systems);
 
 template <class S>
 class ReversibleSceneContract : public ::testing::Test {};
-TYPED_TEST_SUITE(ReversibleSceneContract, ReversibleSystems);
+TYPED_TEST_SUITE(ReversibleSceneContract, ReversibleIntegrableSystems);
 
 // Final q, v and energy error of a run of `steps` steps of h.
 template <class S>
@@ -54,34 +56,87 @@ Final<S> run_to_end(const S& sys, const MethodSpec& spec, const Vec<double, S::n
 }
 
 // The declared order is the fitted order, for q(T), v(T) and |E(T) - E0|,
-// against the reference solution (tol 1e-13) over h = 0.1 ... 0.003125, T = 4.
+// against the reference solution (tol 1e-13) over h = 0.1 ... 0.003125, T = 4
+// (coarser h and longer T where a method is too accurate for that: see below).
+// The fit: the errors above 1e-10 (the reference's error and round-off are
+// below), less a finest point that has reached the solves' own floor (its local
+// order jumps by more than 0.5 from the previous one: the robot's triple-jump
+// DLA levels off at 5e-10, where the 1280 steps' solve tolerances add up), and
+// of those the 3 finest (the asymptotic regime: RK4 on the contact oscillator is
+// still pre-asymptotic at h = 0.1, local orders 3.45, 3.79, 3.90).
+constexpr double kFloor = 1e-10;
+std::optional<double> asymptotic_order(const std::vector<double>& hs, const std::vector<double>& errs) {
+  OrderFit f = fit_order(hs, errs, kFloor);
+  auto local = [&](size_t j) { return std::log(f.error[j - 1] / f.error[j]) / std::log(f.h[j - 1] / f.h[j]); };
+  const size_t n = f.h.size();
+  if (n >= 4 && std::abs(local(n - 1) - local(n - 2)) > 0.5) {
+    f.h.pop_back();
+    f.error.pop_back();
+  }
+  return fit_order(f.h, f.error, kFloor, 3).order;
+}
 TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
   using S = TypeParam;
   const S sys = make_system<S>();
   std::mt19937 rng(21);
-  Vec<double, S::n> q0, v0, qref, vref;
-  random_state<S>(rng, &q0, &v0);
+  Vec<double, S::n> qr, vr;
+  random_state<S>(rng, &qr, &vr);
   const double T = 4.0;
-  reference_solution(sys, q0, v0, T, 1e-13, &qref, &vref);
-  const double Eref = std::abs(energy(sys, qref, vref) - energy(sys, q0, v0));
   for (const StudyMethod& m : fixed_step_methods()) {
-    const int p = method_traits(sys, m.spec).order;
+    const MethodTraits traits = method_traits(sys, m.spec);
+    const int p = traits.order;
+    const bool fit_energy = p <= 2 && !traits.preserves_energy;
     std::vector<double> hs, eq, ev, eE;
-    // Order 6 reaches the floor 1e-10 by h ~ 0.02: start it at 0.2 for enough
-    // points above it (at 0.4 the 9-stage robot run is not yet asymptotic).
-    for (double h = p >= 6 ? 0.2 : 0.1; h > 0.003; h /= 2) {
-      const Final<S> f = run_to_end(sys, m.spec, q0, v0, h, std::lround(T / h));
-      ASSERT_TRUE(f.rep.ok) << m.label() << ": " << f.rep.reason;
-      hs.push_back(h);
-      eq.push_back((f.q - qref).cwiseAbs().maxCoeff());
-      ev.push_back((f.v - vref).cwiseAbs().maxCoeff());
-      eE.push_back(std::abs(f.dE - Eref));
+    auto above = [&](const std::vector<double>& e) {
+      return std::count_if(e.begin(), e.end(), [&](double x) { return x > kFloor; });
+    };
+    auto enough = [&] { return above(eq) >= 3 && above(ev) >= 3 && (!fit_energy || above(eE) >= 3); };
+    // From a random state; where a method is so accurate there that even h = 0.8
+    // leaves fewer than 3 errors above the floor (mp06+order6 on the sleigh, whose
+    // random state turns slowly; a longer T does not help, the sleigh damps
+    // velocity errors), from the scene's default state instead.
+    Vec<double, S::n> q0 = qr, v0 = vr;
+    const char* state = "random";
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      if (attempt == 1) q0 = S::default_q0(), v0 = S::default_v0(), state = "default";
+      Vec<double, S::n> qref, vref;
+      reference_solution(sys, q0, v0, T, 1e-13, &qref, &vref);
+      const double Eref = std::abs(energy(sys, qref, vref) - energy(sys, q0, v0));
+      hs.clear(), eq.clear(), ev.clear(), eE.clear();
+      auto run_at = [&](double h, bool front) {
+        const Final<S> f = run_to_end(sys, m.spec, q0, v0, h, std::lround(T / h));
+        EXPECT_TRUE(f.rep.ok) << m.label() << " h " << h << ": " << f.rep.reason;
+        const auto at = [&](std::vector<double>& v, double x) { front ? (void)v.insert(v.begin(), x) : v.push_back(x); };
+        at(hs, h);
+        at(eq, f.rep.ok ? (f.q - qref).cwiseAbs().maxCoeff() : NAN);
+        at(ev, f.rep.ok ? (f.v - vref).cwiseAbs().maxCoeff() : NAN);
+        at(eE, f.rep.ok ? std::abs(f.dE - Eref) : NAN);
+      };
+      // Order 6 reaches the floor by h ~ 0.02: start it at 0.2 for enough points
+      // above it (at 0.4 the 9-stage robot run is not yet asymptotic).
+      for (double h = p >= 6 ? 0.2 : 0.1; h > 0.003; h /= 2) run_at(h, false);
+      // Where fewer than 3 errors of q, v or (where it is fitted) the energy are
+      // above the floor (mp06+order6 on the contact oscillators; the symmetric
+      // DLA's energy error on the free sleigh, of order 4), coarser h first, up
+      // to 0.8 (T / h stays an integer).
+      while (!enough() && hs.front() < 0.8) run_at(2 * hs.front(), true);
+      if (enough()) break;
     }
     const double tol = p >= 4 ? 0.2 : (p == 2 ? 0.1 : 0.15);  // as test_convergence always had
-    const OrderFit fq = fit_order(hs, eq, 1e-10), fv = fit_order(hs, ev, 1e-10), fE = fit_order(hs, eE, 1e-10);
-    ASSERT_TRUE(fq.order && fv.order) << m.label() << ": too few points above the floor";
-    std::printf("    %-14s declared %d, fitted q %.3f, v %.3f, energy %s; q errors", m.label().c_str(), p, *fq.order,
-                *fv.order, fE.order ? std::to_string(*fE.order).c_str() : "-");
+    struct {
+      std::optional<double> order;
+    } fq{asymptotic_order(hs, eq)}, fv{asymptotic_order(hs, ev)}, fE{asymptotic_order(hs, eE)};
+    if (!(fq.order && fv.order)) {
+      std::string errs;
+      for (size_t j = 0; j < hs.size(); ++j) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, " h %g: q %.2e v %.2e;", hs[j], eq[j], ev[j]);
+        errs += buf;
+      }
+      FAIL() << m.label() << ": too few points above the floor from the " << state << " state:" << errs;
+    }
+    std::printf("    %-14s %s state, declared %d, fitted q %.3f, v %.3f, energy %s; q errors", m.label().c_str(), state, p,
+                *fq.order, *fv.order, fE.order ? std::to_string(*fE.order).c_str() : "-");
     for (double e : eq) std::printf(" %.2e", e);
     std::printf("\n");
     EXPECT_NEAR(*fq.order, p, tol) << m.label() << " (q)";
@@ -89,7 +144,7 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
     // order (higher is possible: RK4's v on the robot fits 5.2 over these h, its
     // energy error at T = 4 is partly below the floor and pre-asymptotic, so it
     // is not fitted; a first-order velocity formula in a second-order method fails).
-    const MethodTraits t = method_traits(sys, m.spec);
+    const MethodTraits& t = traits;
     const int pv = t.velocity_order ? t.velocity_order : p;
     EXPECT_GT(*fv.order, pv - tol) << m.label() << " (the reported velocity, declared order " << pv << ")";
     if (p <= 2 && !t.preserves_energy) {  // (an energy-preserving method's is round-off)
@@ -114,14 +169,15 @@ TYPED_TEST(MethodContract, SymmetricMethodsAreReversibleAndOthersAreNot) {
     random_state<S>(rng, &q0, &v0);
     for (const StudyMethod& m : fixed_step_methods()) {
       for (double h : {0.2, -0.2}) {
-        with_stepper(sys, m.spec, [&](auto& st) {
-          st.start(q0, v0);
-          const Vec<double, 2 * n> z0 = st.phase();
-          EXPECT_TRUE(st.step(h).ok()) << m.label();
-          const Vec<double, 2 * n> z1 = st.phase();
-          EXPECT_TRUE(st.step(-h).ok()) << m.label();
-          const Vec<double, 2 * n> z2 = st.phase();
-          const MethodTraits t = st.traits();
+        {
+          const auto st = make_stepper(sys, m.spec);
+          st->start(q0, v0);
+          const Vec<double, 2 * n> z0 = st->phase();
+          EXPECT_TRUE(st->step(h).ok()) << m.label();
+          const Vec<double, 2 * n> z1 = st->phase();
+          EXPECT_TRUE(st->step(-h).ok()) << m.label();
+          const Vec<double, 2 * n> z2 = st->phase();
+          const MethodTraits t = st->traits();
           const double scale = 1.0 + z0.cwiseAbs().maxCoeff() + z1.cwiseAbs().maxCoeff();
           const double dq = (z2.template head<n>() - z0.template head<n>()).cwiseAbs().maxCoeff() / scale;
           const double dz = (z2 - z0).cwiseAbs().maxCoeff() / scale;
@@ -132,10 +188,10 @@ TYPED_TEST(MethodContract, SymmetricMethodsAreReversibleAndOthersAreNot) {
               EXPECT_LE(dz, 64 * kEps * t.stages) << m.label() << " h " << h;
             }
           } else {
-            EXPECT_GT(dq, 1e-9) << m.label() << " h " << h << ": a non-symmetric method returned";
+            // 100 times the symmetric methods' bound (RK4 on the sleigh returns to 1e-10).
+            EXPECT_GT(dq, 100 * 64 * kEps * t.stages) << m.label() << " h " << h << ": a non-symmetric method returned";
           }
-          return 0;
-        });
+        }
       }
     }
   }
@@ -203,8 +259,9 @@ TYPED_TEST(MethodContract, ReportedSamplesAndSolvesAreWhatTheMethodPromises) {
         const double scale = 1.0 + s.q.cwiseAbs().maxCoeff() / h + s.v.cwiseAbs().maxCoeff();
         EXPECT_LE(s.discrete_constraint.cwiseAbs().maxCoeff(), 64 * kEps * scale) << sm.label() << " k " << k;
       }
-      if (t.holds_velocity_constraint) {
-        EXPECT_LE(constraint_values(sys, s.q, s.v).cwiseAbs().maxCoeff(), 64 * kEps * (1 + s.v.cwiseAbs().maxCoeff()));
+      if (t.holds_velocity_constraint) {  // v = V(q, p): rounded relative to |p| too (p = v + a(q))
+        const double size = std::max(s.v.cwiseAbs().maxCoeff(), s.has_p ? s.p.cwiseAbs().maxCoeff() : 0.0);
+        EXPECT_LE(constraint_values(sys, s.q, s.v).cwiseAbs().maxCoeff(), 64 * kEps * (1 + size));
       }
     }
   }
@@ -235,7 +292,9 @@ TYPED_TEST(MethodContract, DlaMultiplierIsTheIndexReducedMultiplier) {
   EXPECT_LT(worst, 0.02 * size) << "lambda_k / -h against the index-reduced multiplier";
 }
 
-// Symmetric methods keep the energy bounded on reversible scenes: the largest
+// Symmetric methods keep the energy bounded on reversible integrable scenes
+// (reversible KAM theory, Modin & Verdier 2020; not asserted on the chaotic
+// oscillator or the sleigh, which are reversible but not integrable): the largest
 // |E - E0| in the last quarter of T = 4000 (h = 0.2) is no larger than in the first.
 TYPED_TEST(ReversibleSceneContract, SymmetricMethodsKeepTheEnergyBounded) {
   using S = TypeParam;

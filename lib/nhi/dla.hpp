@@ -246,8 +246,10 @@ class DlaStepper {
  private:
   Map map_;
   std::optional<VecN> p0_;
-  VecN q_prev_, q_curr_, q_next_, p_curr_, p_next_, v0_;
-  VecM lambda_;
+  // Set by start(); zero until then (so that an unstarted stepper copies cleanly).
+  VecN q_prev_ = VecN::Zero(), q_curr_ = VecN::Zero(), q_next_ = VecN::Zero(), p_curr_ = VecN::Zero(),
+       p_next_ = VecN::Zero(), v0_ = VecN::Zero();
+  VecM lambda_ = VecM::Zero();
   long steps_ = 0;
   double h_ = 0, h_prev_ = 0;
 };

@@ -27,6 +27,7 @@
 #include "nhi/integrate.hpp"
 #include "nhi/method_spec.hpp"
 #include "nhi/mp06.hpp"
+#include "nhi/run.hpp"
 #include "nhi/typelist.hpp"
 
 namespace nhi {
@@ -160,19 +161,6 @@ auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
   });
   if (!out) throw std::invalid_argument("unknown method \"" + spec.kind + "\"");
   return std::move(*out);
-}
-
-// Run spec on sys from (q0, v0) with step h for `steps` steps.
-template <class S, class Observer>
-RunReport run_method(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0,
-                     const Vec<double, S::n>& v0, double h, long steps, Observer&& observe) {
-  return with_stepper(sys, spec, [&](auto& stepper) { return integrate(stepper, q0, v0, h, steps, observe); });
-}
-
-// The method's declared traits (order, symmetry, ...), for tests and studies.
-template <class S>
-MethodTraits method_traits(const S& sys, const MethodSpec& spec) {
-  return with_stepper(sys, spec, [](auto& stepper) { return stepper.traits(); });
 }
 
 // The methods the studies run, in a fixed order: every method's "main"

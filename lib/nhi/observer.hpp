@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -14,6 +15,19 @@
 #include "nhi/integrate.hpp"
 
 namespace nhi {
+
+// The array first_integrals() returns (an empty one for systems without them).
+template <class S, bool = has_first_integrals<S>::value>
+struct FirstIntegralsOf {
+  using type = std::array<double, 0>;
+};
+template <class S>
+struct FirstIntegralsOf<S, true> {
+  using type = decltype(std::declval<const S&>().first_integrals(std::declval<Vec<double, S::n>>(),
+                                                                 std::declval<Vec<double, S::n>>()));
+};
+template <class S>
+using FirstIntegrals = typename FirstIntegralsOf<S>::type;
 
 template <class S>
 class Recorder {
@@ -33,6 +47,7 @@ class Recorder {
       const double ca = std::abs(c[a]);
       max_c_ = (std::isnan(ca) || ca > max_c_) ? ca : max_c_;
     }
+    if constexpr (has_first_integrals<S>::value) pending_I_ = sys_.first_integrals(s.q, s.v);
     pending_ = s;
     pending_E_ = E;
     pending_c_ = c;
@@ -41,7 +56,7 @@ class Recorder {
     return true;
   }
 
-  // Write t, q, v, energy, constraint (and p, lambda, discrete_constraint for the DLA) and summary.
+  // Write t, q, v, energy, constraint (first_integrals for systems that have them; p, lambda, discrete_constraint for the DLA) and summary.
   void write(nlohmann::json* out) {
     flush();  // the last point reached, if it was not on the stride
     auto& o = *out;
@@ -50,6 +65,14 @@ class Recorder {
     o["v"] = rows(v_, n);
     o["energy"] = E_;
     o["constraint"] = rows(c_, m);
+    if constexpr (has_first_integrals<S>::value) {
+      const auto names = S::first_integral_names();
+      for (size_t i = 0; i < names.size(); ++i) {
+        std::vector<double> col;
+        for (size_t k = i; k < I_.size(); k += names.size()) col.push_back(I_[k]);
+        o["first_integrals"][names[i]] = col;
+      }
+    }
     if (has_p_) {
       o["p"] = rows(p_, n);
       o["lambda"] = rows(lambda_, m);
@@ -70,6 +93,7 @@ class Recorder {
     v_.insert(v_.end(), s.v.data(), s.v.data() + n);
     E_.push_back(pending_E_);
     c_.insert(c_.end(), pending_c_.data(), pending_c_.data() + m);
+    if constexpr (has_first_integrals<S>::value) I_.insert(I_.end(), pending_I_.begin(), pending_I_.end());
     if (s.has_p) {
       has_p_ = true;
       p_.insert(p_.end(), s.p.data(), s.p.data() + n);
@@ -91,6 +115,8 @@ class Recorder {
   double pending_E_ = 0;
   Vec<double, m> pending_c_;
   bool have_pending_ = false, has_p_ = false;
+  FirstIntegrals<S> pending_I_{};
+  std::vector<double> I_;  // the system's first integrals besides the energy, row-major
   std::vector<double> t_, q_, v_, E_, c_, p_, lambda_, wd_;
 };
 

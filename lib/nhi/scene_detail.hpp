@@ -110,6 +110,7 @@ S make_system(const json& params, json* resolved) {
     }
     sys.*(p->member) = finite_number(value, k);
     if (p->check == ParamCheck::kPositive && !(sys.*(p->member) > 0)) fail(k, "must be > 0, got " + show(value));
+    if (p->check == ParamCheck::kNonNegative && !(sys.*(p->member) >= 0)) fail(k, "must be >= 0, got " + show(value));
   }
   *resolved = json::object();
   for (const auto& entry : table) (*resolved)[entry.name] = sys.*(entry.member);

@@ -17,6 +17,11 @@
 //   static constexpr int l;  template <class T> Vec<T,l> g(const Vec<T,n>& q) const;
 // and capability declarations the tests and studies select on (traits below):
 //   static constexpr bool reversible = true;  // L, omega invariant under (q, v) -> (q, -v)
+//   static constexpr bool integrable = true;  // ... and integrable: reversible KAM theory
+//                                             // bounds a reversible method's energy error
+//   first_integral_names(), first_integrals(q, v)  // conserved quantities besides the energy
+//   exact_solution(q0, v0, t, &q, &v)          // a closed form (returns false where it has none)
+//   section_states(count), section_coordinate  // initial states for Poincare sections
 //   shape, group                              // a Chaplygin split (reduced.hpp)
 //   nonholonomic_momentum, momentum_equation_rhs   // a symmetry for eq. (24)
 //   reduced_flow                               // an independent exact reduced description
@@ -43,7 +48,7 @@ namespace nhi {
 
 // A scene parameter: its name in the scene's `params`, the member it sets, and
 // what the validator requires of it (every number must also be finite).
-enum class ParamCheck { kFinite, kPositive };
+enum class ParamCheck { kFinite, kPositive, kNonNegative };
 template <class S>
 struct Param {
   const char* name;
@@ -56,6 +61,33 @@ template <class S, class = void>
 struct is_reversible : std::false_type {};
 template <class S>
 struct is_reversible<S, std::enable_if_t<S::reversible>> : std::true_type {};
+
+// Reversible and integrable: the class on which Modin & Verdier (Numer. Math.
+// 145, 2020) show by reversible KAM theory that reversible methods keep the
+// energy bounded; the tests assert that only there.
+template <class S, class = void>
+struct is_reversible_integrable : std::false_type {};
+template <class S>
+struct is_reversible_integrable<S, std::enable_if_t<S::reversible && S::integrable>> : std::true_type {};
+
+// First integrals besides the energy: names and values at (q, v).
+template <class S, class = void>
+struct has_first_integrals : std::false_type {};
+template <class S>
+struct has_first_integrals<S, std::void_t<decltype(S::first_integral_names())>> : std::true_type {};
+
+// A closed-form solution: bool exact_solution(q0, v0, t, &q, &v) const.
+template <class S, class = void>
+struct has_exact_solution : std::false_type {};
+template <class S>
+struct has_exact_solution<S, std::void_t<decltype(&S::exact_solution)>> : std::true_type {};
+
+// A family of initial states for Poincare sections (study_poincare).
+template <class S, class = void>
+struct has_section_states : std::false_type {};
+template <class S>
+struct has_section_states<S, std::void_t<decltype(std::declval<const S&>().section_states(1)),
+                                         decltype(S::section_coordinate)>> : std::true_type {};
 
 // One of the paper's own scenes (section 6), where its claims are asserted as stated.
 template <class S, class = void>

@@ -35,6 +35,18 @@ struct Front<TypeList<T, Ts...>> {
   using type = T;
 };
 
+// The I-th type of a list.
+template <class List, int I>
+struct At;
+template <class T, class... Ts>
+struct At<TypeList<T, Ts...>, 0> {
+  using type = T;
+};
+template <class T, class... Ts, int I>
+struct At<TypeList<T, Ts...>, I> {
+  using type = typename At<TypeList<Ts...>, I - 1>::type;
+};
+
 // Concatenation and filtering by a trait Pred<T>::value.
 template <class... Ls>
 struct Concat;

@@ -99,16 +99,16 @@ double available_bytes() {
 // arrays around them) and as text (up to 25 bytes), with a per-point overhead
 // for the row arrays.  Measured: particle DLA, 10^6 points, peak RSS 1.12 GB
 // (1120 bytes per point, a 282 MB result file); this estimate gives 1320.
-double estimated_bytes_per_point(int n, int m, bool has_p) {
-  const int numbers = 1 + n + n + 1 + m + (has_p ? n + m + m : 0);
+double estimated_bytes_per_point(int n, int m, bool has_p, int first_integrals) {
+  const int numbers = 1 + n + n + 1 + m + first_integrals + (has_p ? n + m + m : 0);
   const int rows = 4 + (has_p ? 3 : 0);
   return numbers * (8.0 + 16.0 + 25.0 + 16.0) + rows * 64.0;
 }
 
-void refuse_if_too_large(const json& r, int n, int m) {
+void refuse_if_too_large(const json& r, int n, int m, int first_integrals) {
   const long steps = r["steps"], every = r["output_every"];
   const double points = double(steps / every) + 2;
-  const double bytes = points * estimated_bytes_per_point(n, m, method_flags(r["method"]).reports_p);
+  const double bytes = points * estimated_bytes_per_point(n, m, method_flags(r["method"]).reports_p, first_integrals);
   const double avail = available_bytes();
   if (bytes > avail) {
     const double per_point = bytes / points;
@@ -236,7 +236,7 @@ json validate_scene(const json& scene) {
     }
     r["q0"] = to_json(q0);
     r["v0"] = to_json(v0);
-    refuse_if_too_large(r, S::n, S::m);
+    refuse_if_too_large(r, S::n, S::m, static_cast<int>(std::tuple_size<FirstIntegrals<S>>::value));
     return 0;
   });
   r["params"] = params;

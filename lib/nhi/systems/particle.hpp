@@ -33,6 +33,9 @@ struct Particle {
 
   // L and omega are invariant under (q, v) -> (q, -v): the standard reversing symmetry.
   static constexpr bool reversible = true;
+  // Integrable: E and the y energy 1/2 yd^2 + ky y^2 are conserved and z is cyclic, so
+  // the reduced flow has two degrees of freedom and two integrals (system.hpp).
+  static constexpr bool integrable = true;
   static constexpr const char* paper_section = "6.1";
   // L = 1/2 v^T M v - U(q) with M constant (hamiltonian.hpp).
   static constexpr bool separable = true;

@@ -43,6 +43,8 @@ struct Robot {
 
   // L and omega are invariant under (q, v) -> (q, -v): the standard reversing symmetry.
   static constexpr bool reversible = true;
+  // Integrable: thetad is constant, psi a pendulum, x and y quadratures (reduced_flow).
+  static constexpr bool integrable = true;
   static constexpr const char* paper_section = "6.2";
   // L = 1/2 v^T M v - U(q) with M constant (hamiltonian.hpp).
   static constexpr bool separable = true;

@@ -1,0 +1,61 @@
+// Running a method by its MethodSpec on a registered system, compiled once.
+//
+// run_method(), method_traits() and make_stepper() below are declared here and
+// instantiated for every registered system (systems/registry.hpp) in the
+// library, one translation unit per system (lib/src/system_slot.cpp), so that a
+// study, a test or the runner that runs methods by name does not compile every
+// method's stepper and Newton solver again.  The observer is called through a
+// std::function (one indirect call per time point; the arithmetic of a run is
+// the same as with integrate() on the concrete stepper, bit for bit).
+//
+// Code that wants the concrete stepper type (a benchmark, a test of one
+// method's internals) uses with_stepper() or the stepper classes directly
+// (methods.hpp).
+#pragma once
+
+#include <functional>
+#include <memory>
+
+#include "nhi/method_spec.hpp"
+#include "nhi/stepper.hpp"
+
+namespace nhi {
+
+template <int n, int m>
+using SampleObserver = std::function<bool(const Sample<n, m>&)>;
+
+// A stepper of any method, behind virtual calls (stepper.hpp describes the role).
+template <int n, int m>
+class AnyStepper {
+ public:
+  virtual ~AnyStepper() = default;
+  virtual MethodTraits traits() const = 0;
+  virtual int lag() const = 0;
+  virtual void start(const Vec<double, n>& q0, const Vec<double, n>& v0) = 0;
+  virtual StepSummary step(double h) = 0;
+  virtual void sample(Sample<n, m>* s) const = 0;
+  virtual Vec<double, 2 * n> phase() const = 0;  // (q, p) or (q, v) of the newest point
+};
+
+// Run spec on sys from (q0, v0) with step h for `steps` steps (integrate.hpp).
+template <class S>
+RunReport run_spec(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+                   double h, long steps, const SampleObserver<S::n, S::m>& observe);
+
+// The method's declared traits (order, symmetry, ...), for tests and studies.
+template <class S>
+MethodTraits method_traits(const S& sys, const MethodSpec& spec);
+
+// The stepper spec names, type-erased; an unknown name throws.
+template <class S>
+std::unique_ptr<AnyStepper<S::n, S::m>> make_stepper(const S& sys, const MethodSpec& spec);
+
+// run_spec with any callable observer (held by reference for the call).
+template <class S, class Observer>
+RunReport run_method(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0,
+                     const Vec<double, S::n>& v0, double h, long steps, Observer&& observe) {
+  const SampleObserver<S::n, S::m> ref = [&observe](const Sample<S::n, S::m>& s) { return bool(observe(s)); };
+  return run_spec<S>(sys, spec, q0, v0, h, steps, ref);
+}
+
+}  // namespace nhi

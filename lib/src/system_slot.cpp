@@ -1,0 +1,69 @@
+// Compiled once per registered system (CMakeLists.txt builds it with
+// NHI_SYSTEM_SLOT = 0, 1, ..., NHI_SYSTEM_SLOTS - 1): the definitions of
+// run.hpp for the system at that position of `Systems`.  Splitting by system
+// lets the two cores build the method instantiations in parallel, once.
+#include <type_traits>
+#include <utility>
+
+#include "nhi/methods.hpp"
+#include "nhi/run.hpp"
+#include "nhi/systems/registry.hpp"
+
+#ifndef NHI_SYSTEM_SLOT
+#error "build with -DNHI_SYSTEM_SLOT=i"
+#endif
+
+namespace nhi {
+
+static_assert(Systems::size == NHI_SYSTEM_SLOTS,
+              "CMakeLists.txt counts the systems of systems/registry.hpp; the count does not match");
+
+namespace {
+
+template <class St>
+class Holder final : public AnyStepper<St::n, St::m> {
+ public:
+  explicit Holder(St&& st) : st_(std::move(st)) {}
+  MethodTraits traits() const override { return st_.traits(); }
+  int lag() const override { return St::lag; }
+  void start(const Vec<double, St::n>& q0, const Vec<double, St::n>& v0) override { st_.start(q0, v0); }
+  StepSummary step(double h) override { return st_.step(h); }
+  void sample(Sample<St::n, St::m>* s) const override { st_.sample(s); }
+  Vec<double, 2 * St::n> phase() const override { return st_.phase(); }
+
+ private:
+  St st_;
+};
+
+}  // namespace
+
+template <class S>
+RunReport run_spec(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+                   double h, long steps, const SampleObserver<S::n, S::m>& observe) {
+  return with_stepper(sys, spec, [&](auto& st) { return integrate(st, q0, v0, h, steps, observe); });
+}
+
+template <class S>
+MethodTraits method_traits(const S& sys, const MethodSpec& spec) {
+  return with_stepper(sys, spec, [](auto& st) { return st.traits(); });
+}
+
+template <class S>
+std::unique_ptr<AnyStepper<S::n, S::m>> make_stepper(const S& sys, const MethodSpec& spec) {
+  return with_stepper(sys, spec, [](auto& st) -> std::unique_ptr<AnyStepper<S::n, S::m>> {
+    using St = std::decay_t<decltype(st)>;
+    return std::make_unique<Holder<St>>(std::move(st));
+  });
+}
+
+#if NHI_SYSTEM_SLOT < NHI_SYSTEM_SLOTS
+using SlotSystem = typename At<Systems, NHI_SYSTEM_SLOT>::type;
+template RunReport run_spec<SlotSystem>(const SlotSystem&, const MethodSpec&, const Vec<double, SlotSystem::n>&,
+                                        const Vec<double, SlotSystem::n>&, double, long,
+                                        const SampleObserver<SlotSystem::n, SlotSystem::m>&);
+template MethodTraits method_traits<SlotSystem>(const SlotSystem&, const MethodSpec&);
+template std::unique_ptr<AnyStepper<SlotSystem::n, SlotSystem::m>> make_stepper<SlotSystem>(const SlotSystem&,
+                                                                                         const MethodSpec&);
+#endif
+
+}  // namespace nhi
