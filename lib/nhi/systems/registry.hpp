@@ -9,13 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "nhi/systems/contact_oscillator.hpp"
 #include "nhi/systems/particle.hpp"
 #include "nhi/systems/robot.hpp"
 #include "nhi/typelist.hpp"
 
 namespace nhi {
 
-using Systems = TypeList<Particle, Robot>;
+using Systems = TypeList<Particle, Robot, ContactOscillator>;
 
 inline std::vector<std::string> registered_system_names() {
   std::vector<std::string> names;
