@@ -9,14 +9,17 @@
 #include <string>
 #include <vector>
 
+#include "nhi/systems/chaotic_oscillator.hpp"
 #include "nhi/systems/contact_oscillator.hpp"
+#include "nhi/systems/contact_oscillator_nr.hpp"
 #include "nhi/systems/particle.hpp"
 #include "nhi/systems/robot.hpp"
+#include "nhi/systems/sleigh.hpp"
 #include "nhi/typelist.hpp"
 
 namespace nhi {
 
-using Systems = TypeList<Particle, Robot, ContactOscillator>;
+using Systems = TypeList<Particle, Robot, ContactOscillator, ContactOscillatorNR, ChaoticOscillator, Sleigh>;
 
 inline std::vector<std::string> registered_system_names() {
   std::vector<std::string> names;
