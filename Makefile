@@ -97,7 +97,7 @@ plots/fig4b_robot_constraint.png: plots/constraint_new.gp plots/style.gp $(filte
 	$(call PLOT,results/robot_fig34,Figure 4b: mobile robot,2)
 
 # One figure per study and registered scene (see STUDY below).
-STUDY_TARGETS := study-convergence study-long-horizon study-stability study-work-precision
+STUDY_TARGETS := study-convergence study-long-horizon study-stability study-work-precision study-poincare
 
 GEOMETRY_FIGURES := plots/geometry_momentum.png plots/geometry_extrinsic.png
 
@@ -135,8 +135,9 @@ $(eval $(call STUDY,convergence,study-convergence))
 $(eval $(call STUDY,long_horizon,study-long-horizon))
 $(eval $(call STUDY,stability,study-stability))
 $(eval $(call STUDY,work_precision,study-work-precision))
+$(eval $(call STUDY,poincare,study-poincare))
 
-results/convergence.json results/long_horizon.json results/stability.json results/geometry.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
+results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
 	$< --threads $(JOBS) -o $@
 
 # ---- The geometry of the discrete flow (issue 5): eq. 24, eq. 17, Remark 3.3 ---
@@ -148,7 +149,7 @@ plots/geometry_%.png: plots/geometry_%.gp plots/style.gp results/geometry.json
 # Timed studies run after the others (order-only prerequisites), so that no
 # other job shares the two cores while they measure CPU time.
 results/work_precision.json: $(BUILD)/bin/study_work_precision $(SCENES) \
-    | results/convergence.json results/long_horizon.json results/stability.json results/geometry.json $(RUNS) \
+    | results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json $(RUNS) \
       $(COMPANION_RUNS)
 	$< --threads $(JOBS) -o $@
 study-work-precision: results/step_costs.json
@@ -158,7 +159,7 @@ results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 	$< --benchmark_min_time=0.5 -o $@
 
 # Markdown tables of the study results, quoted in README.md.
-results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json \
+results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
     results/stability.json results/step_costs.json
 	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
 

@@ -1,11 +1,14 @@
 // Study 2: energy and constraints over long horizons.
-// h = 0.2, T = 2e5 (10^6 steps) on every registered scene, for every library
+// 10^6 steps of the scene file's h (0.2 on the paper's scenes, T = 2e5; 2 sin(pi/40)
+// on the contact oscillators, as McLachlan & Perlmutter and Modin & Verdier;
+// 0.1 on the chaotic oscillator and the sleigh) on every registered scene, for every library
 // method of nhi::study_methods(): the "main" ones (DLA alpha = 1/2, symmetric
 // DLA alpha = 0, RK4, the reference solution) and the "variant"s (alpha = 0,
 // 1/4, 3/4, 1; symmetric alpha = 1/4), whose energy fate the table states.
 // Nothing holds every step: the observer keeps, at ~40 log-spaced checkpoints
 // per decade, the instantaneous energy error and constraint value and their
-// running maxima over every step, plus block means of E - E0 over blocks of
+// running maxima over every step (and the same for the system's other first
+// integrals, H_y and R of the contact oscillators), plus block means of E - E0 over blocks of
 // 1000 steps for the drift rate.
 #include "study.hpp"
 
@@ -14,14 +17,13 @@ namespace {
 using nhi::Vec;
 using study::json;
 
-constexpr double kH = 0.2;
 constexpr long kSteps = 1000000;
 constexpr long kBlock = 1000;
 
 template <class S>
 class HorizonObserver {
  public:
-  HorizonObserver(const S& sys, long steps) : sys_(sys) {
+  HorizonObserver(const S& sys, long steps, double h) : sys_(sys), h_(h) {
     for (double x = 0; x <= std::log10(double(steps)) + 1e-9; x += 1.0 / 40) {
       const long k = std::lround(std::pow(10.0, x));
       if (checkpoints_.empty() || k > checkpoints_.back()) checkpoints_.push_back(k);
@@ -34,11 +36,17 @@ class HorizonObserver {
     const double dE = E - E0_;
     const double c = nhi::constraint_values(sys_, s.q, s.v).cwiseAbs().maxCoeff();
     if (!std::isfinite(dE) || !std::isfinite(c)) return false;  // a non-finite state ends the run
+    if constexpr (nhi::has_first_integrals<S>::value) {
+      const auto I = sys_.first_integrals(s.q, s.v);
+      if (s.k == 0) I0_.assign(I.begin(), I.end()), max_dI_.assign(I.size(), 0.0);
+      for (size_t i = 0; i < I.size(); ++i) max_dI_[i] = std::max(max_dI_[i], std::abs(I[i] - I0_[i]));
+      last_I_.assign(I.begin(), I.end());
+    }
     max_dE_ = std::max(max_dE_, std::abs(dE));
     max_c_ = std::max(max_c_, c);
     block_sum_ += dE;
     if (++block_n_ == kBlock) {
-      block_t_.push_back((s.k - (kBlock - 1) / 2.0) * kH);
+      block_t_.push_back((s.k - (kBlock - 1) / 2.0) * h_);
       block_mean_.push_back(block_sum_ / kBlock);
       block_sum_ = 0;
       block_n_ = 0;
@@ -49,6 +57,7 @@ class HorizonObserver {
       env_dE_.push_back(max_dE_);
       c_.push_back(c);
       env_c_.push_back(max_c_);
+      for (size_t i = 0; i < max_dI_.size(); ++i) env_dI_.resize(max_dI_.size()), env_dI_[i].push_back(max_dI_[i]);
       ++next_;
     }
     last_t_ = s.t;
@@ -93,11 +102,23 @@ class HorizonObserver {
                            {"t90", std::isfinite(t90) ? json(t90) : json(nullptr)},
                            {"E0", E0_},
                            {"last_t", last_t_}}}};
+    if constexpr (nhi::has_first_integrals<S>::value) {
+      const auto names = S::first_integral_names();
+      for (size_t i = 0; i < names.size() && i < max_dI_.size(); ++i) {
+        j["first_integrals"][names[i]] = {{"max_abs_error", env_dI_.size() > i ? json(env_dI_[i]) : json::array()},
+                                          {"initial", I0_[i]},
+                                          {"final_error", last_I_[i] - I0_[i]}};
+        j["summary"]["max_abs_" + std::string(names[i]) + "_error"] = max_dI_[i];
+      }
+    }
     return j;
   }
 
  private:
   S sys_;
+  double h_;
+  std::vector<double> I0_, max_dI_, last_I_;
+  std::vector<std::vector<double>> env_dI_;
   std::vector<long> checkpoints_;
   size_t next_ = 0;
   double E0_ = 0, max_dE_ = 0, max_c_ = 0, block_sum_ = 0, last_t_ = 0;
@@ -134,7 +155,7 @@ int main(int argc, char** argv) {
   const study::Options opt = study::parse(argc, argv, "Energy and constraints over long horizons, every scene");
   const std::vector<nhi::StudyMethod> methods = study::methods([](const nhi::StudyMethod& m) { return !m.external; });
   json result = {{"study", "long_horizon"},
-                 {"config", {{"h", kH}, {"steps", kSteps}, {"T", kH * kSteps}, {"block", kBlock},
+                 {"config", {{"h", "per scene: the scene file's h"}, {"steps", kSteps}, {"block", kBlock},
                              {"drift_rate", "least-squares slope of block means of E - E0 against t"},
                              {"envelope_growth_exponent", "log-log slope of max_{s<=t} |E - E0| over t in [T/1000, T]"},
                              {"fate", "blows up if a step solve failed or the state became non-finite; dissipates/grows if |mean of E - E0 over the last 10% of blocks| > |E0|/2 (t: when max |E - E0| reached 90% of its final value); drifts if the envelope growth exponent >= 0.1; else bounded"}}}};
@@ -153,15 +174,16 @@ int main(int argc, char** argv) {
     const nhi::StudyMethod& m = methods[i % methods.size()];
     runs[i] = nhi::visit_scene(scene_json[i / methods.size()], [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
-      HorizonObserver<S> obs(sys, kSteps);
+      const double h = scene_json[i / methods.size()]["h"].get<double>();
+      HorizonObserver<S> obs(sys, kSteps, h);
       const double c0 = study::thread_cpu_seconds();
-      const nhi::RunReport rep = nhi::run_method(sys, m.spec, q0, v0, kH, kSteps, obs);
+      const nhi::RunReport rep = nhi::run_method(sys, m.spec, q0, v0, h, kSteps, obs);
       json j = obs.to_json();
       j["cpu_seconds"] = study::thread_cpu_seconds() - c0;
       j["label"] = m.label();
       j["style"] = m.style();
       j["group"] = m.group;
-      j.update(study::report_json(rep, kH));
+      j.update(study::report_json(rep, h));
       if (rep.failure == nhi::FailureKind::kObserver) j["failure"]["reason"] = "non-finite energy or constraint";
       j["fate"] = fate(j);
       return j;
@@ -170,7 +192,8 @@ int main(int argc, char** argv) {
   for (size_t s = 0; s < scenes.size(); ++s) {
     json ms = json::array();
     for (size_t k = 0; k < methods.size(); ++k) ms.push_back(runs[s * methods.size() + k]);
-    result["scenes"][scenes[s]] = {{"scene", scene_json[s]}, {"methods", ms}};
+    result["scenes"][scenes[s]] = {{"scene", scene_json[s]}, {"h", scene_json[s]["h"]}, {"T", scene_json[s]["h"].get<double>() * kSteps},
+                                   {"methods", ms}};
   }
   return study::finish(opt, result);
 }

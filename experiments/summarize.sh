@@ -19,13 +19,35 @@ jq -r "$G"'
    "| \(.[0].label) | \(map(.fitted_order | g) | join(" | ")) |")' "$R/convergence.json"
 echo
 
-echo "## Long horizon (results/long_horizon.json): h = 0.2, T = 2e5"
+echo "## Long horizon (results/long_horizon.json): 10^6 steps of the scene's h (0.2 on the paper's scenes: T = 2e5)"
 echo
 echo "| scene | method | max \\|E-E0\\| | drift rate (per unit t) | envelope exponent | max \\|constraint\\| | fate | CPU s |"
 echo "|---|---|---|---|---|---|---|---|"
 jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] |
   "| \($s) | \(.label) | \(.summary.max_abs_energy_error | g) | \(.summary.drift_rate | g) | \(.summary.envelope_growth_exponent | g) | \(.summary.max_abs_constraint | g) | \(.fate | gsub("[|]"; "\\|")) | \(.cpu_seconds | g) |"' "$R/long_horizon.json"
 echo
+
+echo "### Long horizon: the other first integrals (contact oscillators: H_y = (y^2 + yd^2)/2, R = H - H_y)"
+echo
+echo "| scene | method | max \\|H_y - H_y0\\| | max \\|R - R0\\| | R - R0 at the end | fate of E |"
+echo "|---|---|---|---|---|---|"
+jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] | select(.first_integrals != null) |
+  "| \($s) | \(.label) | \(.summary.max_abs_H_y_error | g) | \(.summary.max_abs_R_error | g) | \(.first_integrals.R.final_error | g) | \(.fate | gsub("[|]"; "\\|")) |"' "$R/long_horizon.json"
+echo
+
+if [ -f "$R/poincare.json" ]; then
+echo "## Poincare sections (results/poincare.json): (z, zd) at each maximum of y, h = 2 sin(pi/40), 10 initial states, 24000 steps"
+echo
+echo "Thickness: median over 36 angular bins of the radial spread of a state's section points, as a ratio to the"
+echo "reference solution's; median over the 10 states. max |y - 1|: the error of y's amplitude (y at the sections is"
+echo "y's maximum); the first integrals are read at the grid point after each section."
+echo
+echo "| scene | method | thickness / reference | max \\|R - R0\\| at sections | max \\|H_y - H_y0\\| | max \\|y - 1\\| | all ok | CPU s |"
+echo "|---|---|---|---|---|---|---|---|"
+jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] |
+  "| \($s) | \(.label) | \(.summary.median_thickness_ratio | g) | \(.summary.max_abs_R_error | g) | \(.summary.max_abs_H_y_error | g) | \(.summary.max_abs_y_minus_y0 | g) | \(.summary.all_ok) | \(.summary.cpu_seconds | g) |"' "$R/poincare.json"
+echo
+fi
 
 echo "## Stability (results/stability.json): T = 200, h = 0.01 ... 10"
 echo

@@ -11,14 +11,20 @@ group(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].group' %s", scene, i, f
 # Line style of method i: 10 + its fixed style (plots/style.gp).
 sty(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
 N = int(system(sprintf("jq '.scenes.%s.methods | length' %s", scene, file)))
+H = system(sprintf("jq -r '.scenes.%s.h' %s", scene, file))
+T = real(system(sprintf("jq -r '.scenes.%s.T' %s", scene, file)))
+# Systems with first integrals besides E (the contact oscillators: H_y, R) get a fourth panel.
+FI = system(sprintf("jq -r '.scenes.%s.methods[0].first_integrals // {} | keys | join(\" \")' %s", scene, file))
+fiseries(i, name) = sprintf("< jq -r '.scenes.%s.methods[%d] | select(.group == \"main\") | [.t, .first_integrals.%s.max_abs_error] | transpose[] | select(.[1] > 0) | @tsv' %s", scene, i, name, file)
 set logscale xy
 set format x "10^{%L}"
 set format y "10^{%L}"
 set xlabel "t"
 set key outside below font ",8" spacing 0.9 maxrows 6
-set xrange [0.2:3e5]
+set xrange [H:1.5*T]
 set style data lines
-set multiplot layout 1,3 title sprintf("Long horizon, h = 0.2, T = 2x10^5 (%s)", scene)
+if (strlen(FI) > 0) { set terminal pngcairo size 1500,1300 enhanced font "DejaVu Sans,10" linewidth 1.2; set output out }
+set multiplot layout (strlen(FI) > 0 ? 2 : 1),3 title sprintf("Long horizon, h = %s, 10^6 steps, T = %.4g (%s)", H, T, scene) noenhanced
 set title "max_{s <= t} |E - E_0|"
 set yrange [1e-17:1e3]
 plot for [i=0:N-1] series(i, "max_energy_error", "main") u 1:2 ls sty(i) t (group(i) eq "main" ? label(i) : "")
@@ -29,4 +35,11 @@ set title "variants (other alphas, more compositions): max_{s <= t} |E - E_0|"
 set yrange [1e-12:1e6]
 set format y "10^{%L}"
 plot for [i=0:N-1] series(i, "max_energy_error", "variant") u 1:2 ls sty(i) t (group(i) eq "variant" ? label(i) : "")
+if (strlen(FI) > 0) {
+  set yrange [1e-17:1e3]
+  do for [w in FI] {
+    set title sprintf("main methods: max_{s <= t} |%s - %s_0|", w, w) noenhanced
+    plot for [i=0:N-1] fiseries(i, w) u 1:2 ls sty(i) t (group(i) eq "main" ? label(i) : "")
+  }
+}
 unset multiplot

@@ -33,8 +33,13 @@ struct OrderFit {
   std::vector<std::optional<double>> local;   // h.size() - 1 entries
 };
 
+//
+// With drop_floor_tail, the finest points that sit on a floor higher than
+// `floor` (the accumulated error of the implicit solves, or of the reference)
+// are dropped first: while the local order between the last two points differs
+// by more than 0.5 from the one before it, the last point goes.
 inline OrderFit fit_order(const std::vector<double>& hs, const std::vector<double>& errs, double floor,
-                          size_t finest = 0) {
+                          size_t finest = 0, bool drop_floor_tail = false) {
   OrderFit f;
   for (size_t j = 0; j < hs.size(); ++j) {
     const bool ok = std::isfinite(errs[j]);
@@ -48,6 +53,12 @@ inline OrderFit fit_order(const std::vector<double>& hs, const std::vector<doubl
       else
         f.local.push_back(std::nullopt);
     }
+  }
+  auto order_at = [&](size_t j) { return std::log(f.error[j - 1] / f.error[j]) / std::log(f.h[j - 1] / f.h[j]); };
+  while (drop_floor_tail && f.h.size() >= 4 &&
+         std::abs(order_at(f.h.size() - 1) - order_at(f.h.size() - 2)) > 0.5) {
+    f.h.pop_back();
+    f.error.pop_back();
   }
   if (finest > 0 && f.h.size() > finest) {  // keep the finest
     f.h.erase(f.h.begin(), f.h.end() - finest);
