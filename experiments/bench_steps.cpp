@@ -214,6 +214,14 @@ int main(int argc, char** argv) {
       if (r["name"] == name) return r["cpu_ns"].get<double>();
     return std::nan("");
   };
+  // Each scene's steps as a ratio to that scene's RK4 step in this run.
+  for (auto& r : rep.rows) {
+    const std::string name = r["name"];
+    const std::string scene = name.substr(0, name.find('/'));
+    const double rk4 = ns(scene + "/rk4");
+    if (name.find("reference_run") == std::string::npos && std::isfinite(rk4))
+      r["ratio_to_rk4"] = r["cpu_ns"].get<double>() / rk4;
+  }
   nhi::json result = {{"study", "step_costs"}, {"benchmarks", rep.rows}};
   const double floor = ns("particle/analytic_newton_floor"), dla = ns("particle/dla_map_alpha0.5");
   result["particle_dla_over_floor"] = std::isfinite(floor) && std::isfinite(dla) ? nhi::json(dla / floor) : nhi::json(nullptr);

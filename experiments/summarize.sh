@@ -59,9 +59,9 @@ echo
 
 echo "## Step costs (results/step_costs.json), CPU ns per step (CVODE: ms per run to T = 200)"
 echo
-echo "| benchmark | CPU |"
-echo "|---|---|"
-jq -r '.benchmarks[] | "| \(.name) | \(.cpu_ns | round) |"' "$R/step_costs.json"
+echo "| benchmark | CPU | / RK4 (same scene, same run) | Newton iterations per step |"
+echo "|---|---|---|---|"
+jq -r "$G"'.benchmarks[] | "| \(.name) | \(.cpu_ns | round) | \(if .ratio_to_rk4 then (.ratio_to_rk4 * 100 | round / 100 | tostring) else "-" end) | \(if .counters.newton_iterations_per_step then (.counters.newton_iterations_per_step * 100 | round / 100 | tostring) else "-" end) |"' "$R/step_costs.json"
 echo
 jq -r "$G"'"Particle DLA step / analytic Newton floor: \(.particle_dla_over_floor | g) (target <= \(.target_ratio))"' "$R/step_costs.json"
 echo

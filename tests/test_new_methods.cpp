@@ -68,6 +68,62 @@ TYPED_TEST(SeparableTest, Mp06GeneralAndSeparableFormsAgree) {
   EXPECT_LE((fast.lambda() - full.lambda()).cwiseAbs().maxCoeff(), 1e-11 * (1 + fast.lambda().cwiseAbs().maxCoeff()));
 }
 
+// The explicit mp06 step (mp06.hpp, explicit_structure): where the structural
+// probe says omega(q1) does not depend on lambda, that holds at random states
+// and parameters too (autodiff through the step), and the direct m x m solve is
+// the Newton solve of the same equations to round-off, over 50 steps.  The
+// probe's verdict on the scenes whose structure we know by hand: the particle,
+// the robot and the contact and chaotic oscillators are explicit, the sleigh
+// with a != 0 is not (its constraint force turns theta), the knife edge is.
+TYPED_TEST(SeparableTest, Mp06ExplicitStepIsTheNewtonStep) {
+  using S = TypeParam;
+  const S sys = make_system<S>();
+  const bool is_explicit = Mp06Stepper<S, true>::explicit_structure(sys);
+  const std::string name = S::name;
+  if (name == "particle" || name == "robot" || name == "contact_oscillator" || name == "chaotic_oscillator")
+    EXPECT_TRUE(is_explicit) << name;
+  if constexpr (std::is_same_v<S, Sleigh>) {
+    EXPECT_FALSE(is_explicit);
+    Sleigh knife = sys;
+    knife.a = 0;
+    EXPECT_TRUE((Mp06Stepper<Sleigh, true>::explicit_structure(knife)));
+  }
+  if (!is_explicit) return;
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  using J = ceres::Jet<double, S::m>;
+  for (int trial = 0; trial < 20; ++trial) {
+    const S rs = randomized_system<S>(rng);
+    Vec<double, S::n> q0, p0;
+    for (int i = 0; i < S::n; ++i) {
+      q0[i] = u(rng);
+      p0[i] = u(rng);
+    }
+    const Mp06SeparableProblem<S> prob(rs, 0.1 + 0.2 * trial / 20.0, q0, p0);
+    Vec<J, S::m> lj;
+    for (int a = 0; a < S::m; ++a) lj[a] = J(u(rng), a);
+    Vec<J, S::n> q1, p1, v1;
+    prob.template state<J>(lj, &q1, &p1, &v1);
+    const Mat<J, S::m, S::n> W1 = rs.template omega<J>(q1);
+    for (int a = 0; a < S::m; ++a)
+      for (int j = 0; j < S::n; ++j) EXPECT_EQ(W1(a, j).v.cwiseAbs().maxCoeff(), 0.0) << trial;
+  }
+  Mp06Stepper<S, true> direct(sys), newton(sys, {}, false);
+  ASSERT_TRUE(direct.is_explicit());
+  ASSERT_FALSE(newton.is_explicit());
+  direct.start(S::default_q0(), S::default_v0());
+  newton.start(S::default_q0(), S::default_v0());
+  for (int k = 0; k < 50; ++k) {
+    const StepSummary sd = direct.step(0.2), sn = newton.step(0.2);
+    ASSERT_TRUE(sd.ok() && sn.ok());
+    EXPECT_EQ(sd.iterations, 0);  // no Newton iteration was needed
+  }
+  const auto z1 = direct.phase(), z2 = newton.phase();
+  EXPECT_LE((z1 - z2).cwiseAbs().maxCoeff(), 1e-12 * (1 + z1.cwiseAbs().maxCoeff()));
+  EXPECT_LE((direct.lambda() - newton.lambda()).cwiseAbs().maxCoeff(),
+            1e-11 * (1 + direct.lambda().cwiseAbs().maxCoeff()));
+}
+
 // mp06 on the particle in closed form (McLachlan & Perlmutter eq. 4.18 with
 // V = p, F = (-2 kx x, -2 ky y, 0), omega = (-y, 0, 1)): the y row of the
 // constraint force is zero, so y1 is explicit and the constraint

@@ -164,8 +164,45 @@ class Mp06Stepper {
   using VecN = Vec<double, n>;
   using VecM = Vec<double, m>;
 
-  explicit Mp06Stepper(const S& sys, SolverOptions options = {}) : sys_(sys), options_(options) {}
+  // allow_explicit = false always solves by Newton (tests compare the two).
+  explicit Mp06Stepper(const S& sys, SolverOptions options = {}, bool allow_explicit = true)
+      : sys_(sys), options_(options), explicit_(allow_explicit && explicit_structure(sys)) {}
   const S& system() const { return sys_; }
+
+  // Is the step explicit?  For a separable system, q1 = q_half + (h/2) V(p_base
+  // + h omega(q_half)^T lambda), and when the rows of omega depend only on
+  // coordinates whose velocities the constraint force does not change (the
+  // particle: omega depends on y, the force acts on x and z; the robot: on
+  // theta, the force on x, y, psi; the contact and chaotic oscillators; the
+  // knife edge), omega(q1) does not depend on lambda and the constraint
+  // omega(q1) V(p1) = 0 is linear in lambda: one m x m solve.  Detected by
+  // autodiff: d omega(q1(lambda)) / d lambda is exactly zero (a structural
+  // zero, not a small number) at two unrelated states.
+  static bool explicit_structure(const S& sys) {
+    if constexpr (!kSeparable) {
+      return false;
+    } else {
+      using J = ceres::Jet<double, m>;
+      for (int probe = 0; probe < 2; ++probe) {
+        VecN q0, p0;
+        for (int i = 0; i < n; ++i) {
+          q0[i] = 0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i;
+          p0[i] = -0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i;
+        }
+        const Mp06SeparableProblem<S> prob(sys, 0.3, q0, p0);
+        Vec<J, m> lj;
+        for (int a = 0; a < m; ++a) lj[a] = J(0.1 * (a + 1), a);
+        Vec<J, n> q1, p1, v1;
+        prob.template state<J>(lj, &q1, &p1, &v1);
+        const Mat<J, m, n> W1 = sys.template omega<J>(q1);
+        for (int a = 0; a < m; ++a)
+          for (int j = 0; j < n; ++j)
+            if (!(W1(a, j).v.array() == 0.0).all()) return false;
+      }
+      return true;
+    }
+  }
+  bool is_explicit() const { return explicit_; }
 
   MethodTraits traits() const {
     MethodTraits t;
@@ -190,6 +227,7 @@ class Mp06Stepper {
     StepSummary s;
     if constexpr (kSeparable) {
       const Mp06SeparableProblem<S> prob(sys_, h, q0, p0);
+      if (explicit_ && explicit_map(prob, q1, p1, lambda, &s)) return s;
       VecM y = *lambda;
       Vec<double, 0> none;
       s = NewtonSolver<Mp06SeparableProblem<S>>(prob, options_).solve(&y, &none);
@@ -209,6 +247,56 @@ class Mp06Stepper {
       }
     }
     return s;
+  }
+
+  // The explicit step (see explicit_structure()): with lambda = 0, q1* and
+  // v1* = V(p_base); omega(q1*) = omega(q1) for every lambda, and V is linear in
+  // p, so omega(q1*) [v1* + sum_a lambda_a V(h omega(q_half)^T e_a)] = 0 is an
+  // m x m linear system.  The result is checked by one evaluation of the
+  // residual; if it is not within tolerance the caller falls back to Newton.
+  bool explicit_map(const Mp06SeparableProblem<S>& prob, VecN* q1, VecN* p1, VecM* lambda, StepSummary* s) const {
+    VecN qs, ps, vs;
+    prob.template state<double>(VecM::Zero(), &qs, &ps, &vs);
+    const Mat<double, m, n> W1 = sys_.template omega<double>(qs);
+    Mat<double, m, m> A;
+    for (int a = 0; a < m; ++a) A.col(a) = W1 * velocity<S, double>(sys_, prob.q_half, VecN(prob.hWt.col(a)));
+    // Closed-form m x m inverse (m <= 4); a nearly singular A goes to Newton.
+    const double det = A.determinant();
+    double amax = A.cwiseAbs().maxCoeff(), scale = 1;
+    for (int a = 0; a < m; ++a) scale *= amax;
+    if (!(std::abs(det) > 1e-12 * scale)) return false;
+    const VecM l = A.inverse() * VecM(-W1 * vs);
+    VecN qn, pn, vn;
+    prob.template state<double>(l, &qn, &pn, &vn);
+    // The residual omega(q1) V(p1).  With a hand-written V, omega(q1) is W1
+    // bit for bit: the coordinates omega reads get exact zeros from the
+    // constraint force (that is what the structural probe found).  The
+    // generic V solves with pivoted LU, so there omega(q1) is evaluated.
+    Mat<double, m, n> W;
+    if constexpr (has_velocity<S, double>::value) {
+      W = W1;
+    } else {
+      W = sys_.template omega<double>(qn);
+    }
+    double rel = 0;
+    for (int a = 0; a < m; ++a) {
+      double r = 0, terms = 0;
+      for (int j = 0; j < n; ++j) {
+        r += W(a, j) * vn[j];
+        terms += std::abs(W(a, j) * vn[j]);
+      }
+      if (!std::isfinite(r)) return false;
+      rel = std::max(rel, r == 0 ? 0.0 : std::abs(r) / std::max(terms, std::numeric_limits<double>::min()));
+    }
+    if (!(rel <= options_.tolerance)) return false;
+    *q1 = qn;
+    *p1 = pn;
+    *lambda = l;
+    s->status = SolveStatus::kConverged;
+    s->iterations = 0;   // a direct solve
+    s->evaluations = 1;  // the residual check
+    s->relative_residual = rel;
+    return true;
   }
 
   StepSummary step(double h) {
@@ -253,6 +341,7 @@ class Mp06Stepper {
  private:
   S sys_;
   SolverOptions options_;
+  bool explicit_ = false;
   VecN q_ = VecN::Zero(), p_ = VecN::Zero();
   VecM lambda_ = VecM::Zero();
   long steps_ = 0;

@@ -40,6 +40,9 @@ struct SolverOptions {
   double tolerance = 1e-12;  // required relative residual
   int max_iterations = 20;   // Newton iterations before the fallback
   bool fallback = true;      // retry a failed Newton with ceres::TinySolver
+  // Keep the factorization (a chord step) while each iteration shrinks the
+  // relative residual by at least this factor; refresh the Jacobian otherwise.
+  double refresh_ratio = 1e-3;
 };
 
 template <class P>
@@ -110,73 +113,85 @@ class NewtonSolver {
     return rel;
   }
 
-  // The residual alone (no derivatives), judged with the scale of a nearby
-  // Jacobian Jy (the one the chord iterations use): cheap.
-  double evaluate_value(const VecY& y, const VecL& lambda, const Mat<double, N, ny>& Jy, VecX* r) const {
+  // The part of row i's scale that comes from the Jacobian, sum_j |dr_i/dy_j| y_scale_j,
+  // at the point where Jy was evaluated.
+  VecX jacobian_scale(const VecY& y, const Mat<double, N, ny>& Jy) const {
+    return Jy.cwiseAbs() * p_.y_scale(y);
+  }
+
+  // The residual alone (no derivatives), judged with the Jacobian part of the
+  // scale from a nearby point (the one whose Jacobian the chord iterations use): cheap.
+  double evaluate_value(const VecY& y, const VecL& lambda, const VecX& jscale, VecX* r) const {
     VecX terms;
     p_.template residual<double>(y, lambda, r, &terms);
-    const VecY ys = p_.y_scale(y);
     double rel = 0;
-    for (int i = 0; i < N; ++i) {
-      double scale = terms[i];
-      for (int j = 0; j < ny; ++j) scale += std::abs(Jy(i, j)) * ys[j];
-      rel = std::max(rel, ratio((*r)[i], scale));
-    }
+    for (int i = 0; i < N; ++i) rel = std::max(rel, ratio((*r)[i], terms[i] + jscale[i]));
     return rel;
+  }
+
+  // x^k for a small fixed k (std::pow was a tenth of a DLA step).
+  template <int k>
+  static double power(double x) {
+    double p = 1;
+    for (int i = 0; i < k; ++i) p *= x;
+    return p;
   }
 
   // Solves the linear system with the matrix [A  -Wt; B  0], A = df/dy, B = dg/dy.
   // While A is comfortably invertible (for the DLA A ~ -M/h) by the Schur
-  // complement on the fixed-size A (Eigen's closed forms for ny <= 4), else by
-  // pivoted LU of the whole matrix.
+  // complement with closed-form inverses of A and of B A^-1 Wt (ny, nl <= 4),
+  // else by pivoted LU of the whole matrix.
   class LinearSolver {
    public:
     explicit LinearSolver(const Mat<double, ny, nl>& Wt) : Wt_(Wt) {}
     void factor(const Mat<double, N, ny>& Jy) {
       const Mat<double, ny, ny> A = Jy.template topRows<ny>();
       B_ = Jy.template bottomRows<nl>();
-      bool invertible = false;
-      if constexpr (ny <= 4 && nl > 0) {
-        // |det A| against the size of its entries, as det scales: relative 1e-10.
-        A.computeInverseWithCheck(Ainv_, invertible, 1e-10 * std::pow(A.cwiseAbs().maxCoeff(), ny));
-      }
-      if constexpr (nl > 0) {
-        if (invertible) {
-          const Mat<double, nl, nl> Sm = B_ * Ainv_ * Wt_;  // Schur complement B A^-1 Wt
-          schur_.compute(Sm);
-          schur_ok_ = std::isfinite(Sm.sum()) &&
-                      std::abs(schur_.determinant()) > 1e-10 * std::pow(Sm.cwiseAbs().maxCoeff(), nl);
-        } else {
-          schur_ok_ = false;
+      schur_ok_ = false;
+      if constexpr (ny <= 4 && nl > 0 && nl <= 4) {
+        // Closed-form inverses of the fixed-size A and Schur complement (Eigen's
+        // cofactor formulas for n <= 4): |det| against the size of the entries,
+        // as det scales, relative 1e-10.
+        const double detA = A.determinant();
+        if (std::isfinite(detA) && std::abs(detA) > 1e-10 * power<ny>(A.cwiseAbs().maxCoeff())) {
+          Ainv_ = A.inverse();
+          AinvWt_ = Ainv_ * Wt_;
+          const Mat<double, nl, nl> Sm = B_ * AinvWt_;  // Schur complement B A^-1 Wt
+          const double detS = Sm.determinant();
+          if (std::isfinite(detS) && std::abs(detS) > 1e-10 * power<nl>(Sm.cwiseAbs().maxCoeff())) {
+            Sinv_ = Sm.inverse();
+            schur_ok_ = Sinv_.allFinite();
+          }
         }
       }
       if (!schur_ok_) {
         Mat<double, N, N> K = Mat<double, N, N>::Zero();
         K.template leftCols<ny>() = Jy;
-        K.template topRightCorner<ny, nl>() = -Wt_;
+        if constexpr (nl > 0) K.template topRightCorner<ny, nl>() = -Wt_;
         lu_.compute(K);
       }
     }
     VecX solve(const VecX& r) const {
-      if constexpr (nl == 0) {
-        return lu_.solve(r);
-      } else {
-        if (!schur_ok_) return lu_.solve(r);
-        // A dy - Wt dl = r1,  B dy = r2  =>  (B A^-1 Wt) dl = r2 - B A^-1 r1.
-        const VecY z = Ainv_ * r.template head<ny>();
-        const VecL dl = schur_.solve(VecL(r.template tail<nl>() - B_ * z));
-        VecX dx;
-        dx.template head<ny>() = z + Ainv_ * (Wt_ * dl);
-        dx.template tail<nl>() = dl;
-        return dx;
+      if constexpr (ny <= 4 && nl > 0 && nl <= 4) {
+        if (schur_ok_) {
+          // A dy - Wt dl = r1,  B dy = r2  =>  (B A^-1 Wt) dl = r2 - B A^-1 r1.
+          const VecY z = Ainv_ * r.template head<ny>();
+          const VecL dl = Sinv_ * VecL(r.template tail<nl>() - B_ * z);
+          VecX dx;
+          dx.template head<ny>() = z + AinvWt_ * dl;
+          dx.template tail<nl>() = dl;
+          return dx;
+        }
       }
+      return lu_.solve(r);
     }
 
    private:
     Mat<double, ny, nl> Wt_;
     Mat<double, nl, ny> B_;
     Mat<double, ny, ny> Ainv_;
-    Eigen::PartialPivLU<Mat<double, nl, nl>> schur_;
+    Mat<double, ny, nl> AinvWt_;
+    Mat<double, nl, nl> Sinv_;
     Eigen::PartialPivLU<Mat<double, N, N>> lu_;
     bool schur_ok_ = false;
   };
@@ -196,6 +211,7 @@ class NewtonSolver {
     LinearSolver solver(p_.Wt());
     bool fresh = true;  // r, Jy were just evaluated with derivatives at the iterate
     double rel = evaluate(y, lambda, &r, &Jy);
+    VecX jscale = jacobian_scale(y, Jy);
     ++s.evaluations;
     for (int it = 0;; ++it) {
       s.relative_residual = rel;
@@ -223,11 +239,12 @@ class NewtonSolver {
       lambda -= dx.template tail<nl>();
       prev = rel;
       ++s.iterations;
-      rel = evaluate_value(y, lambda, Jy, &r);
+      rel = evaluate_value(y, lambda, jscale, &r);
       ++s.evaluations;
       fresh = false;
-      if (!(rel <= 1e-3 * prev) && !(rel <= kRoundoff)) {  // slow contraction: refresh the Jacobian
+      if (!(rel <= options_.refresh_ratio * prev) && !(rel <= kRoundoff)) {  // slow contraction: refresh the Jacobian
         rel = evaluate(y, lambda, &r, &Jy);
+        jscale = jacobian_scale(y, Jy);
         ++s.evaluations;
         fresh = true;
       }
