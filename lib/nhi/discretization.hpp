@@ -70,7 +70,9 @@ struct SplitDiscretization {
 
 template <class T, int N>
 inline Vec<T, N> interpolate(const Vec<T, N>& q0, const Vec<T, N>& q1, double c) {
-  return cst<T>(1.0 - c) * q0 + cst<T>(c) * q1;
+  Vec<T, N> r;
+  for (int i = 0; i < N; ++i) r[i] = scale(q0[i], 1.0 - c) + scale(q1[i], c);
+  return r;
 }
 
 // L_d(q0, q1) (eq. 9 / 10).
@@ -94,14 +96,17 @@ inline void discrete_lagrangian_slots(const S& sys, const D& disc, double h,
                                       const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
                                       Vec<T, S::n>* D1, Vec<T, S::n>* D2) {
   constexpr int n = S::n;
-  const Vec<T, n> v = (q1 - q0) / cst<T>(h);
+  Vec<T, n> v;
+  for (int i = 0; i < n; ++i) v[i] = divide(T(q1[i] - q0[i]), h);
   if (D1) D1->setConstant(cst<T>(0.0));
   if (D2) D2->setConstant(cst<T>(0.0));
   for (const Node& nd : disc.nodes()) {
     Vec<T, n> Lq, Lv;
     lagrangian_partials(sys, interpolate(q0, q1, nd.c), v, &Lq, &Lv);
-    if (D1) *D1 += cst<T>(nd.weight * h * (1.0 - nd.c)) * Lq - cst<T>(nd.weight) * Lv;
-    if (D2) *D2 += cst<T>(nd.weight * h * nd.c) * Lq + cst<T>(nd.weight) * Lv;
+    for (int i = 0; i < n; ++i) {
+      if (D1) (*D1)[i] += scale(Lq[i], nd.weight * h * (1.0 - nd.c)) - scale(Lv[i], nd.weight);
+      if (D2) (*D2)[i] += scale(Lq[i], nd.weight * h * nd.c) + scale(Lv[i], nd.weight);
+    }
   }
 }
 
@@ -132,7 +137,8 @@ template <class S, class D, class T>
 inline Vec<T, S::m> discrete_constraint(const S& sys, const D& disc, double h,
                                         const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
                                         Vec<double, S::m>* scale = nullptr) {
-  const Vec<T, S::n> v = (q1 - q0) / cst<T>(h);
+  Vec<T, S::n> v;
+  for (int i = 0; i < S::n; ++i) v[i] = divide(T(q1[i] - q0[i]), h);
   Vec<T, S::m> w;
   w.setConstant(cst<T>(0.0));
   if (scale) scale->setZero();

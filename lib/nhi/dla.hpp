@@ -84,7 +84,7 @@ struct DlaStepProblem {
       T force = cst<T>(0.0);
       double fscale = 0;
       for (int a = 0; a < mc; ++a) {
-        force += cst<T>(W_t(i, a)) * lambda[a];
+        force += scale(lambda[a], W_t(i, a));
         fscale += std::abs(W_t(i, a) * value_of(lambda[a]));
       }
       (*r)[i] = cst<T>(p_curr[i]) + D1[i] - force;  // eq. 6, first line
