@@ -29,6 +29,7 @@
 #include <string>
 
 #include "nhi/discretization.hpp"
+#include "nhi/hamiltonian.hpp"
 #include "nhi/solver.hpp"
 #include "nhi/stepper.hpp"
 
@@ -195,21 +196,22 @@ class DlaStepper {
     q_prev_ = q_curr_ = q_next_ = q0;
     p_curr_ = p_next_ = p0_ ? *p0_ : momentum(map_.system(), q0, v0);
     v0_ = v0;
-    lambda_ = VecM::Zero();
+    lambda_ = lambda_prev_ = VecM::Zero();
     steps_ = 0;
     h_prev_ = h_ = 0;
   }
 
   StepSummary step(double h) {
     VecN guess;
-    if (steps_ == 0) {
-      guess = q_curr_ + h * v0_;
-    } else {
-      guess = q_next_ + (h / h_) * (q_next_ - q_curr_);
+    VecM lambda_guess;
+    next_guess(h, &guess, &lambda_guess, true);
+    if (steps_ > 0) {
       q_prev_ = q_curr_;
       q_curr_ = q_next_;
       p_curr_ = p_next_;
     }
+    lambda_prev_ = lambda_;
+    lambda_ = lambda_guess;
     h_prev_ = h_;
     h_ = h;
     map_.set_h(h);
@@ -222,6 +224,51 @@ class DlaStepper {
                    (st.message.empty() ? "non-finite state" : st.message);
     }
     return st;
+  }
+
+  // The starting iterate of the next step, of size h, from the newest point
+  // (q_{k+1}, p_{k+1}) (issue 13).  First step: q_0 + h v_0 and lambda = 0;
+  // second step, or a change of direction: the linear extrapolation of q and
+  // the last multipliers.  Then the multipliers, which carry the factor h (L_d does), extrapolate
+  // lambda_j / h_j linearly in t from the last two steps, and q from the linear
+  // extrapolation q_{k+1} + (h / h_k)(q_{k+1} - q_k) refined, when `refine`, by
+  // one fixed-point pass of eq. (6), first line: with the nodes q_c and the
+  // velocity inside dL/dq frozen at the extrapolation,
+  //     sum_c w_c dL/dqdot(q_c, v) = p_{k+1} - omega(q_{k+1})^T lambda
+  //                                  + h sum_c w_c (1 - c) dL/dq(q_c, v_guess),
+  // solved for v with V(q_cbar, .) (hamiltonian.hpp; exact for a constant mass
+  // matrix; cbar = sum_c w_c c).  For a separable L its error is O(h^4), the
+  // extrapolation's O(h^2) (tests/test_dla.cpp).  A non-finite refinement
+  // keeps the extrapolation.
+  void next_guess(double h, VecN* q_guess, VecM* lambda_guess, bool refine) const {
+    if (steps_ == 0) {
+      *q_guess = q_curr_ + h * v0_;
+      lambda_guess->setZero();
+      return;
+    }
+    *q_guess = q_next_ + (h / h_) * (q_next_ - q_curr_);
+    // Only along a run of steps in one direction: the stages of a composition
+    // (dla_composition.hpp) go back and forth, and there this start cost more
+    // iterations than the plain one (the robot's triple jump: 4.1 per stage).
+    if (steps_ < 2 || !(h * h_ > 0 && h_ * h_prev_ > 0)) {
+      *lambda_guess = lambda_;
+      return;
+    }
+    *lambda_guess = h * (lambda_ / h_ + (h_ / h_prev_) * (lambda_ / h_ - lambda_prev_ / h_prev_));
+    if (!refine) return;
+    const S& sys = map_.system();
+    const VecN& q = q_next_;
+    const VecN vg = (*q_guess - q) / h;
+    VecN rhs = p_next_ - Map::Problem::force_forms(sys, q).transpose() * *lambda_guess;
+    double cbar = 0;
+    for (const Node& nd : map_.discretization().nodes()) {
+      VecN Lq, Lv;
+      lagrangian_partials(sys, VecN((1.0 - nd.c) * q + nd.c * *q_guess), vg, &Lq, &Lv);
+      rhs += (h * nd.weight * (1.0 - nd.c)) * Lq;
+      cbar += nd.weight * nd.c;
+    }
+    const VecN q1 = q + h * velocity<S, double>(sys, VecN((1.0 - cbar) * q + cbar * *q_guess), rhs);
+    if (q1.allFinite()) *q_guess = q1;
   }
 
   // Point k = steps - 1: (q_k, v_k, p_k, lambda_k, omega_d(q_k, q_{k+1})).
@@ -249,7 +296,7 @@ class DlaStepper {
   // Set by start(); zero until then (so that an unstarted stepper copies cleanly).
   VecN q_prev_ = VecN::Zero(), q_curr_ = VecN::Zero(), q_next_ = VecN::Zero(), p_curr_ = VecN::Zero(),
        p_next_ = VecN::Zero(), v0_ = VecN::Zero();
-  VecM lambda_ = VecM::Zero();
+  VecM lambda_ = VecM::Zero(), lambda_prev_ = VecM::Zero();
   long steps_ = 0;
   double h_ = 0, h_prev_ = 0;
 };
