@@ -65,6 +65,20 @@ jq -r "$G"'.benchmarks[] | "| \(.name) | \(.cpu_ns | round) | \(if .ratio_to_rk4
 echo
 jq -r "$G"'"Particle DLA step / analytic Newton floor: \(.particle_dla_over_floor | g) (target <= \(.target_ratio))"' "$R/step_costs.json"
 echo
+echo "The same run as one row per method: ns per step / ratio to that scene's RK4 step / Newton"
+echo "iterations per step (implicit methods; a composition counts every stage's)."
+echo
+jq -r "$G"'
+  [.benchmarks[] | select(.name | test("/") and (test("reference_run|analytic|dla_map") | not))
+   | {scene: (.name | split("/")[0]), method: (.name | split("/")[1]), ns: .cpu_ns, r: .ratio_to_rk4,
+      it: .counters.newton_iterations_per_step}] as $rows |
+  ($rows | map(.scene) | unique) as $scenes |
+  ($rows | map(.method) | reduce .[] as $m ([]; if index([$m]) then . else . + [$m] end)) as $methods |
+  "| method | " + ($scenes | join(" | ")) + " |",
+  "|---|" + ($scenes | map("---|") | join("")),
+  ($methods[] as $m | "| \($m) | " + ([$scenes[] as $s | ($rows[] | select(.scene == $s and .method == $m)) //
+     null | if . == null then "-" else "\(.ns | round) / \(if .r then (.r * 100 | round / 100 | tostring) else "?" end)\(if .it then " / \(.it * 100 | round / 100)" else "" end)" end] | join(" | ")) + " |")' "$R/step_costs.json"
+echo
 
 echo "## Which method when (results/work_precision.json): least CPU time to keep max |E - E0| below a target"
 echo

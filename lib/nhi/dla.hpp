@@ -202,9 +202,12 @@ class DlaStepper {
   }
 
   StepSummary step(double h) {
-    VecN guess;
+    VecN guess, plain;
     VecM lambda_guess;
     next_guess(h, &guess, &lambda_guess, true);
+    const bool predicted = steps_ >= 2 && h * h_ > 0 && h_ * h_prev_ > 0;  // next_guess extrapolated
+    if (predicted) plain = q_next_ + (h / h_) * (q_next_ - q_curr_);
+    const VecM lambda_plain = lambda_;
     if (steps_ > 0) {
       q_prev_ = q_curr_;
       q_curr_ = q_next_;
@@ -216,6 +219,18 @@ class DlaStepper {
     h_ = h;
     map_.set_h(h);
     StepSummary st = map_.step(q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_);
+    if (!st.ok() && predicted) {
+      // A large step can start outside Newton's basin from the predictor
+      // (the sleigh at h = 2): retry from the plain start, the linear
+      // extrapolation and the last multipliers, before the step fails.
+      lambda_ = lambda_plain;
+      StepSummary retry = map_.step(q_curr_, p_curr_, plain, &q_next_, &lambda_, &p_next_);
+      retry.iterations += st.iterations;
+      retry.evaluations += st.evaluations;
+      retry.used_fallback = true;
+      if (!retry.ok()) retry.message = "from the predictor: " + st.message + "; from the extrapolation: " + retry.message;
+      st = retry;
+    }
     ++steps_;
     if (st.status != SolveStatus::kConverged || !q_next_.allFinite()) {
       if (st.status == SolveStatus::kConverged) st.failure = FailureKind::kNonFinite;
