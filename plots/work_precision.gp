@@ -17,7 +17,7 @@ set format x "10^{%L}"
 set format y "10^{%L}"
 set key top right font ",9"
 set style data linespoints
-set multiplot layout 1,2 title sprintf("Work-precision (%s): fixed-step methods over h = 0.4/2^j, adaptive ones over tolerances 1e-3 ... 1e-13", scene)
+set multiplot layout 1,2 title sprintf("Work-precision (%s): fixed-step methods over h = 0.4/2^j, adaptive ones over tolerances 1e-3 ... 1e-13", scene) noenhanced
 set title "error in q at T = 10 against CPU time"
 set xlabel "CPU seconds per run"
 set ylabel "max_i |q_i(T) - q_{ref,i}(T)|"
