@@ -83,9 +83,19 @@ bool long_run(const S& sys, const Config& c) {
   return t.preserves_energy ? c.param >= 0.4 * (1 - 1e-12) : c.param >= 0.1 * (1 - 1e-12);
 }
 
+// The library methods (and the reference solution) run through run_method.
 template <class S, class Sampler>
 bool run_library(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
-                 double T, Sampler&& sample);
+                 double T, Sampler&& sample) {
+  const nhi::StudyMethod& m = c.method;
+  if (m.spec.kind == "benchmark") {  // the reference solution at tolerance param, output every 0.1
+    nhi::MethodSpec spec = m.spec;
+    spec.tolerance = c.param;
+    const double out = 0.1;
+    return nhi::run_method(sys, spec, q0, v0, out, std::lround(T / out), sample).ok;
+  }
+  return nhi::run_method(sys, m.spec, q0, v0, c.param, std::lround(T / c.param), sample).ok;
+}
 
 // A run whose energy error passes max(|E0|, 1) is stopped there and failed
 // (it can meet none of the targets, <= 1e-2): on a non-conservative method
@@ -123,19 +133,6 @@ bool run(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<d
   } catch (const Runaway&) {
     return false;
   }
-}
-
-template <class S, class Sampler>
-bool run_library(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
-                 double T, Sampler&& sample) {
-  const nhi::StudyMethod& m = c.method;
-  if (m.spec.kind == "benchmark") {  // the reference solution at tolerance param, output every 0.1
-    nhi::MethodSpec spec = m.spec;
-    spec.tolerance = c.param;
-    const double out = 0.1;
-    return nhi::run_method(sys, spec, q0, v0, out, std::lround(T / out), sample).ok;
-  }
-  return nhi::run_method(sys, m.spec, q0, v0, c.param, std::lround(T / c.param), sample).ok;
 }
 
 template <class S>

@@ -105,7 +105,7 @@ TYPED_TEST_SUITE(DlaPredictorTest, SeparableSystems);
 
 template <class S, class D>
 void expect_predictor_orders(const D& disc) {
-  constexpr int n = S::n, m = S::m;
+  constexpr int n = S::n;
   const S sys = make_system<S>();
   Vec<double, n> q0, v0;
   scene_state<S>(&q0, &v0);
@@ -117,7 +117,7 @@ void expect_predictor_orders(const D& disc) {
     const long steps = std::lround(1.0 / h);
     for (long k = 0; k < steps; ++k) ASSERT_TRUE(st.step(h).ok());
     Vec<double, n> refined, plain;
-    Vec<double, m + holonomic_count<S>::value> l;
+    typename DlaStepper<S, D>::VecM l;
     st.next_guess(h, &refined, &l, true);
     st.next_guess(h, &plain, &l, false);
     ASSERT_TRUE(st.step(h).ok());

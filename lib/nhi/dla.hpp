@@ -205,8 +205,8 @@ class DlaStepper {
     VecN guess, plain;
     VecM lambda_guess;
     next_guess(h, &guess, &lambda_guess, true);
-    const bool predicted = steps_ >= 2 && h * h_ > 0 && h_ * h_prev_ > 0;  // next_guess extrapolated
-    if (predicted) plain = q_next_ + (h / h_) * (q_next_ - q_curr_);
+    const bool predicted = one_direction(h);  // next_guess extrapolated lambda and refined q
+    if (predicted) plain = extrapolation(h);
     const VecM lambda_plain = lambda_;
     if (steps_ > 0) {
       q_prev_ = q_curr_;
@@ -227,7 +227,7 @@ class DlaStepper {
       StepSummary retry = map_.step(q_curr_, p_curr_, plain, &q_next_, &lambda_, &p_next_);
       retry.iterations += st.iterations;
       retry.evaluations += st.evaluations;
-      retry.used_fallback = true;
+      retry.used_fallback = true;  // counted as a fallback step (RunReport::fallbacks)
       if (!retry.ok()) retry.message = "from the predictor: " + st.message + "; from the extrapolation: " + retry.message;
       st = retry;
     }
@@ -261,11 +261,8 @@ class DlaStepper {
       lambda_guess->setZero();
       return;
     }
-    *q_guess = q_next_ + (h / h_) * (q_next_ - q_curr_);
-    // Only along a run of steps in one direction: the stages of a composition
-    // (dla_composition.hpp) go back and forth, and there this start cost more
-    // iterations than the plain one (the robot's triple jump: 4.1 per stage).
-    if (steps_ < 2 || !(h * h_ > 0 && h_ * h_prev_ > 0)) {
+    *q_guess = extrapolation(h);
+    if (!one_direction(h)) {
       *lambda_guess = lambda_;
       return;
     }
@@ -285,6 +282,14 @@ class DlaStepper {
     const VecN q1 = q + h * velocity<S, double>(sys, VecN((1.0 - cbar) * q + cbar * *q_guess), rhs);
     if (q1.allFinite()) *q_guess = q1;
   }
+
+  // The linear extrapolation q_{k+1} + (h / h_k)(q_{k+1} - q_k) (steps >= 1).
+  VecN extrapolation(double h) const { return q_next_ + (h / h_) * (q_next_ - q_curr_); }
+  // Are this and the last two steps in one direction?  Only then does
+  // next_guess extrapolate and refine: the stages of a composition
+  // (dla_composition.hpp) go back and forth, and there that start cost more
+  // iterations than the plain one (the robot's triple jump: 4.1 per stage).
+  bool one_direction(double h) const { return steps_ >= 2 && h * h_ > 0 && h_ * h_prev_ > 0; }
 
   // Point k = steps - 1: (q_k, v_k, p_k, lambda_k, omega_d(q_k, q_{k+1})).
   void sample(Sample<n, m>* s) const {
