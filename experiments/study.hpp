@@ -1,16 +1,20 @@
 // The study toolkit shared by the study executables: the command line (-o,
-// --threads, --scenes), the registered scenes (systems/registry.hpp) with their
-// scene files, the methods every study runs (nhi::study_methods()), a parallel
-// map over independent runs, a progress line on stderr, per-thread CPU time,
-// a run report as JSON, and writing the result with `meta`.  Each run is
-// independent and deterministic, so results do not depend on the number of
-// threads.  Adding a scene to the registry or a method to study_methods() adds
-// it to every study.
+// --threads, --scenes, --only), the registered scenes (systems/registry.hpp)
+// with their scene files, the methods every study runs (nhi::study_methods()),
+// map_cells() over a study's independent cells (threads within a process, MPI
+// ranks across processes: cluster.hpp), a progress line on stderr, per-thread
+// CPU time, a run report as JSON, and writing the result with `meta` and
+// `stats`.  Each cell is independent and deterministic, so results do not
+// depend on the number of threads or ranks.  Adding a scene to the registry or
+// a method to study_methods() adds it to every study.
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <ctime>
 #include <functional>
@@ -18,9 +22,12 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
+#include "cluster.hpp"
 #include "nhi/fit.hpp"
+#include "nhi/composition.hpp"
 #include "nhi/methods.hpp"
 #include "nhi/run.hpp"
 #include "nhi/output.hpp"
@@ -36,27 +43,54 @@ struct Options {
   std::string out;
   std::string scenes_dir = "experiments/scenes";
   int threads = 2;
+  std::vector<std::string> only;  // registered scenes to run (empty: all)
 };
 
-// Parse the common options and install the interrupt handlers; exits on
-// --help or a bad command line.
-inline Options parse(int argc, char** argv, const std::string& what) {
-  CLI::App app{what};
-  Options o;
+// The wall-clock start of the study (for stats.wall_seconds).
+inline std::chrono::steady_clock::time_point& start_time() {
+  static std::chrono::steady_clock::time_point t = std::chrono::steady_clock::now();
+  return t;
+}
+
+// The common options on `app` (a study adds its own before calling parse).
+inline void add_options(CLI::App& app, Options& o) {
   app.add_option("-o,--output", o.out, "Result file (JSON)")->required();
   app.add_option("--scenes", o.scenes_dir, "Directory with one NAME.json per registered system");
-  app.add_option("--threads", o.threads, "Worker threads")->check(CLI::Range(1, 64));
+  app.add_option("--threads", o.threads, "Worker threads (per rank under MPI)")->check(CLI::Range(1, 64));
+  app.add_option("--only", o.only, "Run only these registered scenes (comma-separated)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(nhi::system_names()));
+}
+
+// Join the ranks (cluster.hpp), parse the command line and install the
+// interrupt handlers; exits on --help or a bad command line (every rank alike).
+inline void parse(CLI::App& app, int argc, char** argv) {
+  start_time();
+  Cluster& cl = Cluster::get();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    std::exit(app.exit(e));
+    // Every rank parses the same line; only the first prints the help or error.
+    cl.exit_all(cl.root() ? app.exit(e) : e.get_exit_code());
   }
   nhi::install_interrupt_handlers();
+}
+
+inline Options parse(int argc, char** argv, const std::string& what) {
+  CLI::App app{what};
+  Options o;
+  add_options(app, o);
+  parse(app, argc, argv);
   return o;
 }
 
-// The registered scenes, in registry order.
-inline std::vector<std::string> scene_names() { return nhi::system_names(); }
+// The scenes to run: the registered ones (or those of --only), in registry order.
+inline std::vector<std::string> scene_names(const Options& o) {
+  std::vector<std::string> out;
+  for (const std::string& name : nhi::system_names())
+    if (o.only.empty() || std::find(o.only.begin(), o.only.end(), name) != o.only.end()) out.push_back(name);
+  return out;
+}
 
 // The validated scene file of a scene name: SCENES/NAME.json.
 inline json scene(const Options& o, const std::string& name) {
@@ -128,21 +162,198 @@ inline json report_json(const nhi::RunReport& rep, double h) {
   return j;
 }
 
-// Write {result..., meta} atomically; an interrupted study writes nothing.
+// ---- Cells: the unit of work distributed over threads and ranks ------------
+
+// The estimated cost of a step of a method, in RK4 steps of the same scene:
+// the per-stage costs of results/step_costs.json on the paper's scenes, rounded,
+// times the composition's stages.  Only the balance of the ranks depends on it.
+inline double step_weight(const nhi::MethodSpec& spec) {
+  double w = 1.0;
+  if (spec.kind == "dla") w = 6.0;
+  else if (spec.kind == "mp06") w = 1.5;
+  else if (spec.kind == "discrete_gradient") w = 40.0;
+  else if (spec.kind == "benchmark") w = 30.0;  // per output interval h
+  const int stages = spec.kind == "benchmark" ? 1 : static_cast<int>(nhi::composition(spec.composition).gamma.size());
+  return w * stages;
+}
+
+// A study's phase of independent cells.  run(i) computes cell i and returns its
+// JSON; it may throw (the study then fails, naming the cell).  cost(i) is the
+// cell's estimated cost (steps times step_weight()), name(i) names it in
+// messages.  A timed phase (its cells measure CPU time) runs on one rank per
+// node only, so that no two timed ranks share a core.
+struct Cells {
+  std::string label;
+  size_t count = 0;
+  std::function<json(size_t)> run;
+  std::function<double(size_t)> cost = [](size_t) { return 1.0; };
+  std::function<std::string(size_t)> name = [](size_t i) { return "cell " + std::to_string(i); };
+  bool timed = false;
+};
+
+// This rank's share of the work so far (finish() reports every rank's in `stats`).
+struct RankStats {
+  long cells = 0;
+  double estimated_cost = 0, busy_seconds = 0;
+};
+inline RankStats& rank_stats() {
+  static RankStats s;
+  return s;
+}
+
+// Owner rank of each cell: longest processing time first, over `ranks` (each
+// cell, by decreasing cost and then index, to the least loaded rank, ties to the
+// lowest).  Every rank computes the same table.
+inline std::vector<int> assign_cells(const Cells& c, const std::vector<int>& ranks) {
+  std::vector<double> cost(c.count);
+  std::vector<size_t> order(c.count);
+  for (size_t i = 0; i < c.count; ++i) {
+    cost[i] = c.cost(i);
+    order[i] = i;
+  }
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cost[a] > cost[b]; });
+  std::vector<double> load(ranks.size(), 0.0);
+  std::vector<int> owner(c.count, ranks.front());
+  for (const size_t i : order) {
+    const size_t r = static_cast<size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    owner[i] = ranks[r];
+    load[r] += cost[i];
+  }
+  return owner;
+}
+
+// Fault injection for the tests (tests/test_cli.cpp): NHI_STUDY_FAIL_CELL=K
+// makes cell K of every phase throw, NHI_STUDY_KILL_CELL=K kills the process
+// that runs it (SIGKILL).  -1 when unset.
+inline long fault_cell(const char* var) {
+  const char* v = std::getenv(var);
+  return v ? std::atol(v) : -1;
+}
+
+// Every cell's JSON, on every rank, in cell order.  This rank computes its
+// cells on o.threads threads, costliest first; under MPI the ranks then exchange results.  A
+// cell that throws, or an interrupt on any rank, ends the study on every rank
+// (exit 1, naming the cell, or 130), before anything is written.
+inline std::vector<json> map_cells(const Options& o, const Cells& c) {
+  Cluster& cl = Cluster::get();
+  std::vector<int> ranks;
+  if (c.timed) {
+    ranks = cl.node_leaders();
+    static bool told = false;
+    if (cl.root() && !told && ranks.size() < static_cast<size_t>(cl.size())) {
+      std::fprintf(stderr, "%s: timed cells run on one rank per node (%zu of %d ranks); the others wait\n",
+                   c.label.c_str(), ranks.size(), cl.size());
+      told = true;
+    }
+  } else {
+    for (int r = 0; r < cl.size(); ++r) ranks.push_back(r);
+  }
+  const std::vector<int> owner = assign_cells(c, ranks);
+  std::vector<size_t> mine;
+  RankStats& st = rank_stats();
+  std::vector<double> cost(c.count);
+  for (size_t i = 0; i < c.count; ++i)
+    if (owner[i] == cl.rank()) {
+      mine.push_back(i);
+      cost[i] = c.cost(i);
+      st.estimated_cost += cost[i];
+    }
+  // Costliest first, so that the threads finish together.
+  std::stable_sort(mine.begin(), mine.end(), [&](size_t a, size_t b) { return cost[a] > cost[b]; });
+  std::vector<json> out(c.count);
+  std::vector<std::pair<size_t, std::string>> errors;
+  std::mutex m;
+  std::atomic<bool> failed{false};
+  const std::string label = cl.parallel() ? c.label + " (rank 0 of " + std::to_string(cl.size()) + ")" : c.label;
+  Progress progress(label, static_cast<long>(mine.size()));
+  const auto t0 = std::chrono::steady_clock::now();
+  const long fail_cell = fault_cell("NHI_STUDY_FAIL_CELL"), kill_cell = fault_cell("NHI_STUDY_KILL_CELL");
+  parallel_for(mine.size(), o.threads, [&](size_t k) {
+    if (failed.load()) return;
+    const size_t i = mine[k];
+    try {
+      if (static_cast<long>(i) == kill_cell) std::raise(SIGKILL);
+      if (static_cast<long>(i) == fail_cell) throw std::runtime_error("injected failure (NHI_STUDY_FAIL_CELL)");
+      out[i] = c.run(i);
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(m);
+      errors.emplace_back(i, e.what());
+      failed = true;
+    }
+  }, cl.root() && !mine.empty() ? &progress : nullptr);
+  st.busy_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.cells += static_cast<long>(mine.size());
+  bool interrupted = nhi::interrupt_flag().load();
+  if (cl.parallel()) {
+    json part = {{"cells", json::array()}, {"errors", json::array()}, {"interrupted", interrupted}};
+    if (!failed && !interrupted)
+      for (const size_t i : mine) part["cells"].push_back({i, std::move(out[i])});
+    for (const auto& e : errors) part["errors"].push_back({e.first, e.second});
+    const std::vector<uint8_t> bytes = json::to_cbor(part);
+    const std::vector<std::string> all = cl.all_gather(std::string(bytes.begin(), bytes.end()));
+    errors.clear();
+    for (const std::string& b : all) {
+      const json p = json::from_cbor(b);
+      interrupted = interrupted || p["interrupted"].get<bool>();
+      for (const json& e : p["errors"]) errors.emplace_back(e[0].get<size_t>(), e[1].get<std::string>());
+      for (const json& cell : p["cells"]) out[cell[0].get<size_t>()] = cell[1];
+    }
+  }
+  if (interrupted) {
+    if (cl.root()) std::fprintf(stderr, "\nstudy: interrupted; nothing written\n");
+    cl.exit_all(130);
+  }
+  if (!errors.empty()) {
+    std::sort(errors.begin(), errors.end());
+    if (cl.root())
+      for (const auto& e : errors)
+        std::fprintf(stderr, "\nstudy: %s: %s failed: %s\n", c.label.c_str(), c.name(e.first).c_str(), e.second.c_str());
+    if (cl.root()) std::fprintf(stderr, "study: failed; nothing written\n");
+    cl.exit_all(1);
+  }
+  return out;
+}
+
+// Write {result..., stats, meta} atomically from the first rank; an interrupted
+// study writes nothing.  Collective: every rank calls it and returns its code.
+// stats: the ranks, threads per rank, and per rank the cells it ran, their
+// estimated cost and its busy (computing) wall seconds.
 inline int finish(const Options& o, json result) {
-  if (nhi::interrupt_flag().load()) {
-    std::cerr << "study: interrupted; nothing written\n";
-    return 130;
+  Cluster& cl = Cluster::get();
+  const RankStats& st = rank_stats();
+  const json mine = {st.cells, st.estimated_cost, st.busy_seconds, nhi::interrupt_flag().load()};
+  const std::vector<uint8_t> bytes = json::to_cbor(mine);
+  json stats = {{"ranks", cl.size()}, {"threads_per_rank", o.threads}, {"cells", json::array()},
+                {"estimated_cost", json::array()}, {"busy_seconds", json::array()}};
+  bool interrupted = false;
+  for (const std::string& b : cl.all_gather(std::string(bytes.begin(), bytes.end()))) {
+    const json r = json::from_cbor(b);
+    stats["cells"].push_back(r[0]);
+    stats["estimated_cost"].push_back(r[1]);
+    stats["busy_seconds"].push_back(r[2]);
+    interrupted = interrupted || r[3].get<bool>();
   }
-  result["meta"] = nhi::meta();
-  try {
-    nhi::AtomicFile f(o.out);
-    f.commit(result.dump() + "\n");
-  } catch (const std::exception& e) {
-    std::cerr << "study: error: " << e.what() << "\n";
-    return 1;
+  stats["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time()).count();
+  int code = 0;
+  if (interrupted) {
+    if (cl.root()) std::cerr << "study: interrupted; nothing written\n";
+    code = 130;
+  } else if (cl.root()) {
+    result["stats"] = stats;
+    result["meta"] = nhi::meta();
+    try {
+      nhi::AtomicFile f(o.out);
+      f.commit(result.dump() + "\n");
+    } catch (const std::exception& e) {
+      std::cerr << "study: error: " << e.what() << "\n";
+      code = 1;
+    }
   }
-  return 0;
+  // Every rank leaves with the first rank's code.
+  const std::vector<std::string> codes = cl.all_gather(std::to_string(code));
+  code = std::atoi(codes.front().c_str());
+  cl.finalize();
+  return code;
 }
 
 // A JSON array of a vector's entries.

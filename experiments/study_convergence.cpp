@@ -27,6 +27,7 @@ struct Variant {
   double alpha = 0.5;
   int style = 0;  // nhi::method_style (0: not a study method)
   std::function<json(double h)> error_at;  // returns {"error", "cpu_seconds", "status"}
+  double weight = 1.0;  // study::step_weight: estimated cost of a step
 };
 
 // Error of one run that ends at q(T).
@@ -53,7 +54,7 @@ std::vector<Variant> variants(const S& sys, const Vec<double, S::n>& q0, const V
     const std::string family = spec.kind == "dla" ? spec.discretization : spec.kind;
     out.push_back({m.label(), family, spec.alpha, m.style(), [=, &sys](double h) {
                      return measure<S>(qref, [&](auto&& obs) { return nhi::run_method(sys, spec, q0, v0, h, steps(h), obs); });
-                   }});
+                   }, study::step_weight(spec)});
   }
   // Isolation: L_d^{aL} with omega_d^{aw}, started from p_0 = dL/dqdot or from the
   // consistent p_0 = dL/dqdot + h (aL - 1/2) dL/dq.
@@ -72,7 +73,7 @@ std::vector<Variant> variants(const S& sys, const Vec<double, S::n>& q0, const V
                        nhi::DlaStepper<S, nhi::SplitDiscretization> st(sys, nhi::SplitDiscretization{iso.aL, iso.aw});
                        st.start_momentum(p0);
                        return measure<S>(qref, [&](auto&& obs) { return nhi::integrate(st, q0, v0, h, steps(h), obs); });
-                     }});
+                     }, study::step_weight(nhi::MethodSpec{})});
     }
   }
   return out;
@@ -97,7 +98,7 @@ int main(int argc, char** argv) {
                  {"config", {{"T", kT}, {"h", hs}, {"reference", "per scene: the exact solution where the system has one, else CVODE Adams rtol = atol = 1e-13"},
                              {"error", "max_i |q_i(T) - q_ref,i(T)|"},
                              {"fit", "least squares of log error on log h over the 4 finest h with error > 1e-10, after dropping finest points on a higher floor (while the last local order differs by > 0.5 from the one before it)"}}}};
-  for (const std::string& name : study::scene_names()) {
+  for (const std::string& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     json scene_out = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
@@ -108,11 +109,13 @@ int main(int argc, char** argv) {
       if constexpr (nhi::has_exact_solution<S>::value) exact = sys.exact_solution(q0, v0, kT, &qref, &vexact);
       if (!exact) qref = study::reference_q(sys, q0, v0, kT, 1e-13);
       const auto vs = variants(sys, q0, v0, qref);
-      std::vector<json> runs(vs.size() * hs.size());
-      study::Progress progress("convergence " + name, static_cast<long>(runs.size()));
-      study::parallel_for(runs.size(), opt.threads, [&](size_t i) {
-        runs[i] = vs[i / hs.size()].error_at(hs[i % hs.size()]);
-      }, &progress);
+      study::Cells cells;
+      cells.label = "convergence " + name;
+      cells.count = vs.size() * hs.size();
+      cells.run = [&](size_t i) { return vs[i / hs.size()].error_at(hs[i % hs.size()]); };
+      cells.cost = [&](size_t i) { return kT / hs[i % hs.size()] * vs[i / hs.size()].weight; };
+      cells.name = [&](size_t i) { return vs[i / hs.size()].label + " at h = " + std::to_string(hs[i % hs.size()]); };
+      const std::vector<json> runs = study::map_cells(opt, cells);
       json methods = json::array();
       for (size_t v = 0; v < vs.size(); ++v) {
         json rs = json::array(), errs = json::array();

@@ -162,8 +162,22 @@ int main(int argc, char** argv) {
                   {"g", series(nhi::DlaStepper<nhi::CircleHolonomic, nhi::AlphaDiscretization>(
                             nhi::CircleHolonomic{}, nhi::AlphaDiscretization{0.5}))}};
     });
-    study::Progress progress("geometry", static_cast<long>(tasks.size()));
-    study::parallel_for(tasks.size(), o.threads, [&](size_t i) { tasks[i](); }, &progress);
+    // Task i fills slots[i]; estimated costs in RK4 steps (the reduced flow's
+    // 200000 steps dominate the convergence task).
+    const std::vector<double> cost = {12000, 12000, 20000, 20000, 12000, 12000, 220000, 30000};
+    const std::vector<const char*> names = {"momentum particle a=1/2", "momentum particle a=1/4", "momentum robot a=1/2",
+                                            "momentum robot a=1/4", "robot intrinsic", "robot extrinsic",
+                                            "robot convergence", "circle (Remark 3.3)"};
+    study::Cells cells;
+    cells.label = "geometry";
+    cells.count = tasks.size();
+    cells.run = [&](size_t i) {
+      tasks[i]();
+      return slots[i];
+    };
+    cells.cost = [&](size_t i) { return cost[i]; };
+    cells.name = [&](size_t i) { return std::string(names[i]); };
+    slots = study::map_cells(o, cells);
     out = {{"study", "geometry"},
            {"momentum", {{"particle", {{"kx", 0.0}, {"ky", particle.ky}, {"runs", {slots[0], slots[1]}}}},
                          {"robot", {{"runs", {slots[2], slots[3]}}}}}},

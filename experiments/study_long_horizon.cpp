@@ -159,20 +159,18 @@ int main(int argc, char** argv) {
                              {"drift_rate", "least-squares slope of block means of E - E0 against t"},
                              {"envelope_growth_exponent", "log-log slope of max_{s<=t} |E - E0| over t in [T/1000, T]"},
                              {"fate", "blows up if a step solve failed or the state became non-finite; dissipates/grows if |mean of E - E0 over the last 10% of blocks| > |E0|/2 (t: when max |E - E0| reached 90% of its final value); drifts if the envelope growth exponent >= 0.1; else bounded"}}}};
-  const std::vector<std::string> scenes = study::scene_names();
-  std::vector<json> runs(scenes.size() * methods.size());
+  const std::vector<std::string> scenes = study::scene_names(opt);
   std::vector<json> scene_json;
   for (const auto& name : scenes) scene_json.push_back(study::scene(opt, name));
-  study::Progress progress("long horizon", static_cast<long>(runs.size()));
-  // Longest runs (the reference solution) first, so the two workers finish together.
-  std::vector<size_t> order(runs.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  auto adaptive = [&](size_t i) { return methods[i % methods.size()].spec.kind == "benchmark"; };
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return adaptive(a) > adaptive(b); });
-  study::parallel_for(runs.size(), opt.threads, [&](size_t oi) {
-    const size_t i = order[oi];
+  study::Cells cells;
+  cells.label = "long horizon";
+  cells.count = scenes.size() * methods.size();
+  // The reference solution's runs are the longest (map_cells starts them first).
+  cells.cost = [&](size_t i) { return kSteps * study::step_weight(methods[i % methods.size()].spec); };
+  cells.name = [&](size_t i) { return scenes[i / methods.size()] + " " + methods[i % methods.size()].label(); };
+  cells.run = [&](size_t i) {
     const nhi::StudyMethod& m = methods[i % methods.size()];
-    runs[i] = nhi::visit_scene(scene_json[i / methods.size()], [&](const auto& sys, const auto& q0, const auto& v0) {
+    return nhi::visit_scene(scene_json[i / methods.size()], [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
       const double h = scene_json[i / methods.size()]["h"].get<double>();
       HorizonObserver<S> obs(sys, kSteps, h);
@@ -188,7 +186,8 @@ int main(int argc, char** argv) {
       j["fate"] = fate(j);
       return j;
     });
-  }, &progress);
+  };
+  const std::vector<json> runs = study::map_cells(opt, cells);
   for (size_t s = 0; s < scenes.size(); ++s) {
     json ms = json::array();
     for (size_t k = 0; k < methods.size(); ++k) ms.push_back(runs[s * methods.size() + k]);

@@ -60,9 +60,27 @@ struct Section {
   std::vector<double> z, zd, y;
   double max_y_drift = 0;
   std::vector<double> max_dI;  // per first integral: max |I - I0| at the sections
-  nhi::RunReport rep;
+  json report;                 // study::report_json of the run
   double cpu = 0;
+  bool ok() const { return report["status"] == "ok"; }
 };
+
+// A Section as a cell's JSON (study::map_cells) and back; doubles round-trip exactly.
+json section_to_json(const Section& s) {
+  return {{"z", s.z}, {"zd", s.zd}, {"y", s.y}, {"max_y_drift", s.max_y_drift}, {"max_dI", s.max_dI},
+          {"report", s.report}, {"cpu", s.cpu}};
+}
+Section section_from_json(const json& j) {
+  Section s;
+  j.at("z").get_to(s.z);
+  j.at("zd").get_to(s.zd);
+  j.at("y").get_to(s.y);
+  s.max_y_drift = j.at("max_y_drift").get<double>();
+  j.at("max_dI").get_to(s.max_dI);
+  s.report = j.at("report");
+  s.cpu = j.at("cpu").get<double>();
+  return s;
+}
 
 // The section: each time y passes a maximum (ydot changes sign from + to -)
 // between two reported points k, k+1, the crossing time is the root of the
@@ -85,7 +103,7 @@ Section run_section(const S& sys, const nhi::MethodSpec& spec, const Vec<double,
     return (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * d0 + (-2 * s3 + 3 * s2) * y1 + (s3 - s2) * d1;
   };
   const double c0 = study::thread_cpu_seconds();
-  sec.rep = nhi::run_method(sys, spec, q0, v0, kH, long(kSections) * kStride, [&](const nhi::Sample<S::n, S::m>& smp) {
+  const nhi::RunReport rep = nhi::run_method(sys, spec, q0, v0, kH, long(kSections) * kStride, [&](const nhi::Sample<S::n, S::m>& smp) {
     if (smp.k == 0) return true;
     const Vec<double, S::n> a = sys.acceleration(smp.q, smp.v);
     if (vp[1] > 0 && smp.v[1] <= 0) {
@@ -113,6 +131,7 @@ Section run_section(const S& sys, const nhi::MethodSpec& spec, const Vec<double,
     return true;
   });
   sec.cpu = study::thread_cpu_seconds() - c0;
+  sec.report = study::report_json(rep, kH);  // every run steps kH, the reference's output included
   return sec;
 }
 
@@ -128,18 +147,25 @@ int main(int argc, char** argv) {
                              {"thickness", "median over 36 angular bins (around the reference section's centre) of max r - min r"},
                              {"first_integrals", "max |I - I0| over the grid points just after each section"},
                              {"precision", "section points rounded to 6 significant digits"}}}};
-  for (const std::string& name : study::scene_names()) {
+  for (const std::string& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     nhi::visit_scene(sc, [&](const auto& sys, const auto&, const auto&) {
       using S = std::decay_t<decltype(sys)>;
       if constexpr (nhi::has_section_states<S>::value) {
         const auto states = sys.section_states(kStates);
-        std::vector<Section> secs(methods.size() * states.size());
-        study::Progress progress("poincare " + name, static_cast<long>(secs.size()));
-        study::parallel_for(secs.size(), opt.threads, [&](size_t i) {
+        study::Cells cells;
+        cells.label = "poincare " + name;
+        cells.count = methods.size() * states.size();
+        cells.run = [&](size_t i) {
           const auto& st = states[i % states.size()];
-          secs[i] = run_section(sys, methods[i / states.size()].spec, st.first, st.second);
-        }, &progress);
+          return section_to_json(run_section(sys, methods[i / states.size()].spec, st.first, st.second));
+        };
+        cells.cost = [&](size_t i) { return double(kSections) * kStride * study::step_weight(methods[i / states.size()].spec); };
+        cells.name = [&](size_t i) {
+          return methods[i / states.size()].label() + ", initial state " + std::to_string(i % states.size());
+        };
+        std::vector<Section> secs;
+        for (const json& j : study::map_cells(opt, cells)) secs.push_back(section_from_json(j));
         // Centres: the mean of the reference's section points, per state.
         size_t ref = 0;
         for (size_t m = 0; m < methods.size(); ++m)
@@ -163,8 +189,8 @@ int main(int argc, char** argv) {
             const Section& s = secs[m * states.size() + j];
             const double th = thickness(s.z, s.zd, cz[j], czd[j]);
             if (std::isfinite(th) && ref_thick[j] > 0) ratios.push_back(th / ref_thick[j]);
-            json r = study::report_json(s.rep, kH);  // every run steps kH, the reference's output included
-            ok = ok && s.rep.ok;
+            json r = s.report;
+            ok = ok && s.ok();
             std::vector<double> z, zd, y;
             for (size_t k = 0; k < s.z.size(); ++k) {
               z.push_back(round6(s.z[k]));

@@ -1,5 +1,5 @@
 // Study 3: where each method fails.
-// h on a geometric grid from 0.01 to 10 (10 per decade), T = 200, every
+// h on a geometric grid from 0.01 to 10 (10 per decade), T = 200 (--T), every
 // registered scene, for every fixed-step method of nhi::study_methods() (the DLA
 // with alpha = 0, 1/4, 1/2, 3/4, 1 and symmetric alpha = 0, 1/4; RK4).
 // A run fails when a step solve does not converge, the state stops being
@@ -15,13 +15,12 @@ namespace {
 using nhi::Vec;
 using study::json;
 
-constexpr double kT = 200.0;
 constexpr double kEnergyThreshold = 1.0;  // relative to |E0|
 
 template <class S>
 json run_one(const S& sys, const nhi::MethodSpec& spec, const Vec<double, S::n>& q0,
-             const Vec<double, S::n>& v0, const Vec<double, S::n>& qref, double h) {
-  const long steps = std::max(1L, std::lround(kT / h));
+             const Vec<double, S::n>& v0, const Vec<double, S::n>& qref, double h, double T) {
+  const long steps = std::max(1L, std::lround(T / h));
   const double E0 = nhi::energy(sys, q0, v0);
   double max_dE = 0, exceeded_at = -1;
   bool nonfinite = false;
@@ -60,26 +59,33 @@ json run_one(const S& sys, const nhi::MethodSpec& spec, const Vec<double, S::n>&
 }  // namespace
 
 int main(int argc, char** argv) {
-  const study::Options opt = study::parse(argc, argv, "Stability: where each method fails, every scene");
+  CLI::App app{"Stability: where each method fails, every scene"};
+  study::Options opt;
+  study::add_options(app, opt);
+  double T = 200.0;
+  app.add_option("--T", T, "Final time of every run")->check(CLI::PositiveNumber);
+  study::parse(app, argc, argv);
   std::vector<double> hs;
   for (int i = 0; i <= 30; ++i) hs.push_back(0.01 * std::pow(10.0, i / 10.0));
   const std::vector<nhi::StudyMethod> methods = study::methods(study::fixed_step);
   json result = {{"study", "stability"},
-                 {"config", {{"T", kT}, {"h", hs},
+                 {"config", {{"T", T}, {"h", hs},
                              {"failure", "step solve not converged (solve), non-finite state (non-finite), or |E - E0| > |E0| (energy)"},
                              {"largest_stable_h", "largest grid h such that every grid h up to it completed within the energy threshold"},
                              {"largest_surviving_h", "largest grid h such that every grid h up to it reached T with converged solves and a finite state"},
                              {"reference", "not swept: the reference solution (CVODE) is adaptive, its h is only the output interval"}}}};
-  for (const auto& name : study::scene_names()) {
+  for (const auto& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
-      const Vec<double, S::n> qref = study::reference_q(sys, q0, v0, kT, 1e-12);
-      std::vector<json> runs(methods.size() * hs.size());
-      study::Progress progress("stability " + name, static_cast<long>(runs.size()));
-      study::parallel_for(runs.size(), opt.threads, [&](size_t i) {
-        runs[i] = run_one(sys, methods[i / hs.size()].spec, q0, v0, qref, hs[i % hs.size()]);
-      }, &progress);
+      const Vec<double, S::n> qref = study::reference_q(sys, q0, v0, T, 1e-12);
+      study::Cells cells;
+      cells.label = "stability " + name;
+      cells.count = methods.size() * hs.size();
+      cells.run = [&](size_t i) { return run_one(sys, methods[i / hs.size()].spec, q0, v0, qref, hs[i % hs.size()], T); };
+      cells.cost = [&](size_t i) { return T / hs[i % hs.size()] * study::step_weight(methods[i / hs.size()].spec); };
+      cells.name = [&](size_t i) { return methods[i / hs.size()].label() + " at h = " + std::to_string(hs[i % hs.size()]); };
+      const std::vector<json> runs = study::map_cells(opt, cells);
       json ms = json::array();
       for (size_t m = 0; m < methods.size(); ++m) {
         json rs = json::array();

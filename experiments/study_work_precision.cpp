@@ -186,7 +186,7 @@ int main(int argc, char** argv) {
                              {"T_long", kT_long}, {"long_scenes", kLongScenes},
                              {"energy_error_long", "max |E - E0| over [0, T_long] (a separate run), on long_scenes only, for fixed steps h >= 0.1 (h = 0.4 for energy-preserving methods) and the explicit adaptive pairs at every tolerance; cpu_energy_long as cpu_energy; status_long = failed (and no max_energy_error_long) when that run failed"},
                              {"failed", "a run is stopped and failed (status = failed, not timed) at a step failure or where |E - E0| passes max(|E0|, 1): no target is met then, and a non-conservative method's energy, and with it an adaptive method's step count, can grow without bound"}}}};
-  for (const std::string& name : study::scene_names()) {
+  for (const std::string& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
@@ -195,10 +195,22 @@ int main(int argc, char** argv) {
       const double E0 = nhi::energy(sys, q0, v0);
       const std::vector<Config> configs = configs_for(sys);
       const bool long_scene = std::find(kLongScenes.begin(), kLongScenes.end(), name) != kLongScenes.end();
-      std::vector<json> rows(configs.size());
-      study::Progress progress("work-precision " + name, static_cast<long>(configs.size()));
-      // Per-thread CPU time is what is measured, so --threads 2 on two cores is fair.
-      study::parallel_for(configs.size(), opt.threads, [&](size_t i) {
+      study::Cells cells;
+      cells.label = "work-precision " + name;
+      cells.count = configs.size();
+      // Per-thread CPU time is what is measured, so --threads 2 on two cores is
+      // fair; under MPI only one rank per node runs cells (timed).
+      cells.timed = true;
+      cells.name = [&](size_t i) { return configs[i].method.label() + " at " + std::to_string(configs[i].param); };
+      // Steps times step_weight for a fixed step; an adaptive run's steps per
+      // unit time grow like tol^(-1/5) (about 10 at tol = 1e-5).
+      cells.cost = [&](size_t i) {
+        const Config& c = configs[i];
+        const double T = kT_final + kT_energy + (long_scene && long_run(sys, c) ? kT_long : 0.0);
+        const bool adaptive = c.method.external || c.method.spec.kind == "benchmark";
+        return adaptive ? T * std::pow(c.param, -0.2) : T / c.param * study::step_weight(c.method.spec);
+      };
+      cells.run = [&](size_t i) {
         const Config& c = configs[i];
         json row = {{"label", c.method.label()}, {"style", c.method.style()},
                     {"adaptive", c.method.external || c.method.spec.kind == "benchmark"}, {"param", c.param}};
@@ -217,8 +229,7 @@ int main(int argc, char** argv) {
         if (!(ok1 && ok2)) {  // not timed: it is never ranked (and might not end unguarded)
           row["failure"] = "stopped at t = " + std::to_string(t_end) +
                            ": step failure, or |E - E0| above max(|E0|, 1) (the energy ran away)";
-          rows[i] = row;
-          return;
+          return row;
         }
         row["cpu_final"] = cpu_per_run(sys, c, q0, v0, kT_final);
         const double cpu_short = cpu_per_run(sys, c, q0, v0, kT_energy_short);
@@ -242,9 +253,9 @@ int main(int argc, char** argv) {
             row["max_energy_error_long_before_failure"] = maxE_long;
           }
         }
-        rows[i] = row;
-      }, &progress);
-      return json{{"scene", sc}, {"runs", rows}};
+        return row;
+      };
+      return json{{"scene", sc}, {"runs", study::map_cells(opt, cells)}};
     });
   }
   return study::finish(opt, result);
