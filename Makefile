@@ -5,12 +5,12 @@
 
 DEB_PACKAGES := cmake ninja-build g++ make libeigen3-dev libceres-dev libsundials-dev \
                 nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev libboost-dev \
-                gnuplot-nox jq
+                gnuplot-nox jq libopenmpi-dev openmpi-bin
 BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2
 
-.PHONY: all deps deps-fuzz build test test-sanitize fuzz reproduce figures clean
+.PHONY: all deps deps-fuzz build test test-sanitize fuzz reproduce figures sweep sweep-scaling clean
 all: build
 
 # $(call APT,packages): apt-get install those of the packages not installed yet.
@@ -165,6 +165,26 @@ results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
     results/stability.json results/step_costs.json
 	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
+
+# ---- The sweep of issue 14 (not part of reproduce): a fate map over h x epsilon
+# x methods x 100 initial states on the contact oscillators, sharded over MPI
+# ranks like every study.  RANKS=N runs it under mpirun with N ranks of
+# THREADS threads each (default: one process of $(JOBS) threads); the result is
+# the same JSON either way (stats aside).
+RANKS ?= 1
+THREADS ?= $(JOBS)
+# Open MPI refuses to run as root (containers, CI) without this flag.
+MPIRUN = mpirun $(if $(filter 0,$(shell id -u)),--allow-run-as-root,)
+sweep: results/fate_map.json
+	$(MAKE) --no-print-directory $$(jq -r '.scenes | keys_unsorted[] | "plots/fate_map_" + . + ".png"' $<)
+results/fate_map.json: $(BUILD)/bin/study_fate_map $(SCENES)
+	$(if $(filter-out 1,$(RANKS)),$(MPIRUN) -np $(RANKS),) $< --threads $(THREADS) -o $@
+plots/fate_map_%.png: plots/fate_map.gp plots/style.gp results/fate_map.json
+	gnuplot -e "file='results/fate_map.json'; scene='$*'; out='$@'" $<
+# Its run time with 1, 2 and 4 ranks of one thread each (4 oversubscribes
+# this machine's two cores: a correctness check, not a speed-up).
+sweep-scaling: $(BUILD)/bin/study_fate_map
+	experiments/sweep_scaling.sh $< "$(MPIRUN)" results/fate_map_scaling.json 1 2 4
 
 clean:
 	rm -rf $(BUILD)

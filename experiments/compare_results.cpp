@@ -39,6 +39,7 @@ using nlohmann::json;
 const std::set<std::string> SKIP_KEYS = {
     "meta",        "wall_seconds", "cpu_seconds", "cpu_ns",   "real_ns",
     "cpu_final",   "cpu_energy",   "peak_rss_kb", "time_utc",
+    "cpu_energy_short", "cpu_energy_long", "busy_seconds",
 };
 // Object keys skipped only inside one file: {file name, key}.
 const std::set<std::pair<std::string, std::string>> SKIP_KEYS_IN_FILE = {

@@ -346,8 +346,12 @@ TEST_F(Cli, StudyResultsDoNotDependOnTheNumberOfThreads) {
   ASSERT_EQ(std::system((std::string(NHI_STABILITY) + " --threads 1 -o " + one + scenes + " 2>/dev/null").c_str()), 0);
   ASSERT_EQ(std::system((std::string(NHI_STABILITY) + " --threads 2 -o " + two + scenes + " 2>/dev/null").c_str()), 0);
   json a = json::parse(std::ifstream(one)), b = json::parse(std::ifstream(two));
-  a.erase("meta");
-  b.erase("meta");
+  EXPECT_EQ(a["stats"]["threads_per_rank"], 1);
+  EXPECT_EQ(b["stats"]["threads_per_rank"], 2);
+  for (json* j : {&a, &b}) {
+    j->erase("meta");
+    j->erase("stats");  // threads and busy times
+  }
   EXPECT_EQ(a, b);  // bit-identical numbers: JSON doubles round-trip exactly
 }
 
