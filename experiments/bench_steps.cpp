@@ -11,6 +11,7 @@
 #include <cstring>
 #include <iostream>
 
+#include "cluster.hpp"
 #include "nhi/methods.hpp"
 #include "nhi/output.hpp"
 #include "nhi/scene.hpp"
@@ -193,18 +194,11 @@ void register_all() {
   });
 }
 
-// Started as one of several MPI ranks (mpirun -np N, srun -n N)?  The
-// benchmark is timed: copies on one node would share its cores, and it is not
-// sharded.  Run it as one process (README, "Running on a cluster").
-int launched_ranks() {
-  for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
-    if (const char* v = std::getenv(var)) return std::atoi(v);
-  return std::getenv("PMIX_RANK") && std::getenv("SLURM_NTASKS") ? std::atoi(std::getenv("SLURM_NTASKS")) : 1;
-}
-
 int main(int argc, char** argv) {
-  if (launched_ranks() > 1) {
-    std::cerr << "bench_steps: started as one of " << launched_ranks()
+  // Timed: copies on one node would share its cores, and it is not sharded
+  // (README, "Running on a cluster").
+  if (study::launcher_ranks() > 1) {
+    std::cerr << "bench_steps: started as one of " << study::launcher_ranks()
               << " ranks; it is timed and not sharded: run it as one process\n";
     return 2;
   }

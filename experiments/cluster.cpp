@@ -6,6 +6,8 @@
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <exception>
 #include <stdexcept>
 
 #ifdef NHI_HAVE_MPI
@@ -16,16 +18,12 @@ namespace study {
 
 namespace {
 
-// Started by mpirun (Open MPI) or srun (PMIx / PMI-2)?  *size: the number
-// of ranks the launcher says it started (1 when it does not say).
-bool launched_by_mpi(int* size) {
-  *size = 1;
-  for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "SLURM_NTASKS"})
-    if (const char* v = std::getenv(var)) {
-      *size = std::max(1, std::atoi(v));
-      break;
-    }
-  return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK");
+// Any MPI launcher in the environment: mpirun (Open MPI), srun with PMIx or
+// PMI-2, or srun without an MPI plugin (SLURM_STEP_NUM_TASKS > 1: then MPI
+// sees one rank per process, and Cluster() refuses to run N copies).
+bool launched_by_mpi() {
+  return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK") ||
+         launcher_ranks() > 1;
 }
 
 #ifdef NHI_HAVE_MPI
@@ -35,9 +33,24 @@ bool g_mpi_open = false;
 void abort_if_open() {
   if (g_mpi_open) MPI_Abort(MPI_COMM_WORLD, 1);
 }
+// An uncaught exception on one rank ends every rank (std::terminate alone
+// would leave the others waiting in a collective under a launcher that does
+// not kill the job).
+void terminate_all() {
+  std::fprintf(stderr, "study: uncaught exception on one rank; aborting every rank\n");
+  std::fflush(stderr);
+  if (g_mpi_open) MPI_Abort(MPI_COMM_WORLD, 1);
+  std::abort();
+}
 #endif
 
 }  // namespace
+
+int launcher_ranks() {
+  for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "SLURM_STEP_NUM_TASKS"})
+    if (const char* v = std::getenv(var)) return std::max(1, std::atoi(v));
+  return 1;
+}
 
 bool built_with_mpi() {
 #ifdef NHI_HAVE_MPI
@@ -53,8 +66,8 @@ Cluster& Cluster::get() {
 }
 
 Cluster::Cluster() {
-  int launched_size = 1;
-  const bool launched = launched_by_mpi(&launched_size);
+  const int launched_size = launcher_ranks();
+  const bool launched = launched_by_mpi();
 #ifdef NHI_HAVE_MPI
   if (!launched) return;
   int provided = 0;
@@ -65,8 +78,19 @@ Cluster::Cluster() {
   }
   mpi_ = g_mpi_open = true;
   std::atexit(abort_if_open);
+  std::set_terminate(terminate_all);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  if (launched_size > 1 && size_ != launched_size) {
+    // srun without --mpi=pmix, or another MPI's launcher: N one-rank jobs
+    // would each run the whole study and race for the output.
+    std::fprintf(stderr,
+                 "study: the launcher started %d tasks but MPI sees %d rank(s) (srun needs --mpi=pmix; or use "
+                 "Open MPI's mpirun)\n",
+                 launched_size, size_);
+    finalize();
+    std::exit(2);
+  }
   MPI_Comm node;
   MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &node);
   int local = 0;
@@ -91,7 +115,10 @@ Cluster::Cluster() {
 std::vector<std::string> Cluster::all_gather(const std::string& mine) const {
   if (!mpi_) return {mine};
 #ifdef NHI_HAVE_MPI
-  if (mine.size() > static_cast<size_t>(INT_MAX)) throw std::runtime_error("study: a rank's results exceed 2 GB");
+  if (mine.size() > static_cast<size_t>(INT_MAX)) {
+    std::fprintf(stderr, "study: rank %d's results exceed 2 GB\n", rank_);
+    abort(1);  // this rank alone knows: end every rank
+  }
   const int len = static_cast<int>(mine.size());
   std::vector<int> lens(size_), offsets(size_);
   MPI_Allgather(&len, 1, MPI_INT, lens.data(), 1, MPI_INT, MPI_COMM_WORLD);
@@ -99,7 +126,7 @@ std::vector<std::string> Cluster::all_gather(const std::string& mine) const {
   for (int r = 0; r < size_; ++r) {
     offsets[r] = static_cast<int>(total);
     total += lens[r];
-    if (total > INT_MAX) throw std::runtime_error("study: gathered results exceed 2 GB");
+    if (total > INT_MAX) throw std::runtime_error("study: gathered results exceed 2 GB");  // every rank alike
   }
   std::string all(static_cast<size_t>(total), '\0');
   MPI_Allgatherv(mine.data(), len, MPI_BYTE, all.data(), lens.data(), offsets.data(), MPI_BYTE, MPI_COMM_WORLD);
@@ -108,6 +135,20 @@ std::vector<std::string> Cluster::all_gather(const std::string& mine) const {
   return out;
 #else
   return {mine};
+#endif
+}
+
+void Cluster::quiet_barrier() const {
+  if (!mpi_) return;
+#ifdef NHI_HAVE_MPI
+  MPI_Request req;
+  MPI_Ibarrier(MPI_COMM_WORLD, &req);
+  for (int done = 0;;) {
+    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    const timespec pause{0, 1000000};  // 1 ms
+    nanosleep(&pause, nullptr);
+  }
 #endif
 }
 

@@ -15,7 +15,8 @@ class Cluster {
  public:
   // The one instance; the first call initialises MPI when the process was
   // started by an MPI launcher (OMPI_COMM_WORLD_SIZE, PMIX_RANK or PMI_RANK in
-  // the environment).  A build without MPI started as several ranks exits 2.
+  // the environment, or srun with several tasks).  A build without MPI started
+  // as several ranks, or ranks that MPI does not see as one job, exit 2.
   static Cluster& get();
 
   int rank() const { return rank_; }
@@ -28,6 +29,9 @@ class Cluster {
 
   // Every rank's bytes, indexed by rank, on every rank (collective).
   std::vector<std::string> all_gather(const std::string& mine) const;
+  // Wait for every rank, sleeping between polls (collective): ranks that have
+  // finished their share do not spin on a core another rank is timing on.
+  void quiet_barrier() const;
 
   // End MPI, on every rank together (collective), before the process exits.
   void finalize();
@@ -48,5 +52,7 @@ class Cluster {
 
 // True when this build can run as several ranks (compiled with MPI).
 bool built_with_mpi();
+// The number of tasks an MPI launcher or srun says it started (1 without one).
+int launcher_ranks();
 
 }  // namespace study

@@ -13,7 +13,8 @@
 // string mismatch is only reported as a "text difference" (method labels may be renamed
 // on purpose). Missing keys, arrays of different length, type mismatches (null vs
 // number included) and changed booleans are "structural" differences. Timing, provenance
-// and machine-dependent keys are skipped (see the constants below).
+// and machine-dependent keys are skipped (see the constants below), and so is a
+// study's `stats` (how the run was split over ranks and threads).
 //
 // Exit status: 0 if no file is missing, there are no structural differences and every
 // max rel diff <= tol; 1 otherwise; 2 on a usage error or unreadable JSON.
@@ -69,6 +70,13 @@ struct Comparer {
   bool skipped(const std::string& key) const {
     return SKIP_KEYS.count(key) || extra_skip.count(key) || SKIP_KEYS_IN_FILE.count({file, key});
   }
+  // A study's `stats` (ranks, threads, per-rank cells and busy times: how
+  // the run was split, not what it computed); a run's `stats` (Newton
+  // counts, steps) is compared.
+  static bool study_stats(const std::string& key, const json& a, const json& b) {
+    auto is = [](const json& j) { return j.is_object() && j.contains("ranks") && j.contains("busy_seconds"); };
+    return key == "stats" && (is(a) || is(b));
+  }
   void structural(const std::string& path, const std::string& what) {
     if (r.structural++ < MAX_LISTED) r.structural_list.push_back((path.empty() ? "(root)" : path) + ": " + what);
   }
@@ -93,13 +101,14 @@ struct Comparer {
       const size_t len = path.size();
       for (auto it = a.begin(); it != a.end(); ++it) {
         if (skipped(it.key())) continue;
+        if (study_stats(it.key(), it.value(), b.contains(it.key()) ? b.at(it.key()) : json())) continue;
         path += (len ? "." : "") + it.key();
         if (!b.contains(it.key())) structural(path, "missing in new");
         else walk(it.value(), b.at(it.key()), path, it.key());
         path.resize(len);
       }
       for (auto it = b.begin(); it != b.end(); ++it)
-        if (!skipped(it.key()) && !a.contains(it.key()))
+        if (!skipped(it.key()) && !study_stats(it.key(), it.value(), json()) && !a.contains(it.key()))
           structural(path + (len ? "." : "") + it.key(), "missing in old");
     } else if (a.is_array()) {
       if (a.size() != b.size())

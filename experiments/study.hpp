@@ -222,7 +222,7 @@ inline std::vector<int> assign_cells(const Cells& c, const std::vector<int>& ran
   return owner;
 }
 
-// Fault injection for the tests (tests/test_cli.cpp): NHI_STUDY_FAIL_CELL=K
+// Fault injection for the tests (tests/test_cluster.cpp): NHI_STUDY_FAIL_CELL=K
 // makes cell K of every phase throw, NHI_STUDY_KILL_CELL=K kills the process
 // that runs it (SIGKILL).  -1 when unset.
 inline long fault_cell(const char* var) {
@@ -279,6 +279,10 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
       std::lock_guard<std::mutex> lock(m);
       errors.emplace_back(i, e.what());
       failed = true;
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(m);
+      errors.emplace_back(i, "unknown exception");
+      failed = true;
     }
   }, cl.root() && !mine.empty() ? &progress : nullptr);
   st.busy_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -290,14 +294,31 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
       for (const size_t i : mine) part["cells"].push_back({i, std::move(out[i])});
     for (const auto& e : errors) part["errors"].push_back({e.first, e.second});
     const std::vector<uint8_t> bytes = json::to_cbor(part);
+    // Ranks without cells (a timed phase) wait asleep, not polling a core
+    // that a timed rank of their node may be using.
+    cl.quiet_barrier();
     const std::vector<std::string> all = cl.all_gather(std::string(bytes.begin(), bytes.end()));
     errors.clear();
+    std::vector<int> received(c.count, 0);
     for (const std::string& b : all) {
       const json p = json::from_cbor(b);
       interrupted = interrupted || p["interrupted"].get<bool>();
       for (const json& e : p["errors"]) errors.emplace_back(e[0].get<size_t>(), e[1].get<std::string>());
-      for (const json& cell : p["cells"]) out[cell[0].get<size_t>()] = cell[1];
+      for (const json& cell : p["cells"]) {
+        const size_t i = cell[0].get<size_t>();
+        out[i] = cell[1];
+        ++received[i];
+      }
     }
+    // Every cell exactly once, or the ranks disagreed on the owner table
+    // (their cost tables differ: another libm on another node?).
+    if (!interrupted && errors.empty())
+      for (size_t i = 0; i < c.count; ++i)
+        if (received[i] != 1) {
+          errors.emplace_back(i, "received from " + std::to_string(received[i]) +
+                                     " ranks (the ranks disagree on which rank runs it)");
+          break;
+        }
   }
   if (interrupted) {
     if (cl.root()) std::fprintf(stderr, "\nstudy: interrupted; nothing written\n");

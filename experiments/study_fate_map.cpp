@@ -105,12 +105,16 @@ int main(int argc, char** argv) {
   int per_decade = 20;
   app.add_option("--param", param, "The swept system parameter");
   app.add_option("--values", g.values, "Its values")->delimiter(',');
-  app.add_option("--states", g.states, "Initial states per (scene, value, method, h)")->check(CLI::Range(1, 100000));
+  app.add_option("--states", g.states, "Initial states per (scene, value, method, h)")->check(CLI::Range(2, 100000));
   app.add_option("--T", g.T, "Final time of every run")->check(CLI::PositiveNumber);
   app.add_option("--h-min", h_min, "Smallest h")->check(CLI::PositiveNumber);
   app.add_option("--h-max", h_max, "Largest h")->check(CLI::PositiveNumber);
   app.add_option("--per-decade", per_decade, "Grid points of h per decade")->check(CLI::Range(1, 1000));
   study::parse(app, argc, argv);
+  if (!(h_max > h_min)) {
+    std::cerr << "study_fate_map: --h-max must exceed --h-min\n";
+    study::Cluster::get().exit_all(2);
+  }
   const int points = static_cast<int>(std::floor(per_decade * std::log10(h_max / h_min) + 1e-9));
   for (int i = 0; i <= points; ++i) g.hs.push_back(h_min * std::pow(10.0, double(i) / per_decade));
   g.methods = study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });

@@ -3,17 +3,27 @@
 # rank, under mpirun; checks that every run's JSON equals the first's (meta and
 # stats aside) and writes {ranks, wall_seconds, busy_seconds, identical, cores}.
 #   experiments/sweep_scaling.sh BINARY "MPIRUN" OUT.json RANKS...
+# (Debian: GNU date and coreutils' nproc.)
 set -eu
+if [ $# -lt 4 ]; then
+  echo "usage: $0 BINARY \"MPIRUN\" OUT.json RANKS..." >&2
+  exit 2
+fi
 bin=$1 mpirun=$2 out=$3
 shift 3
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+trap 'exit 130' INT TERM
 rows=""
 first=""
 mismatch=0
 for n in "$@"; do
   start=$(date +%s.%N)
-  $mpirun --oversubscribe -np "$n" "$bin" --threads 1 -o "$tmp/r$n.json" 2>/dev/null
+  if ! $mpirun --oversubscribe -np "$n" "$bin" --threads 1 -o "$tmp/r$n.json" 2> "$tmp/err$n"; then
+    tr '\r' '\n' < "$tmp/err$n" | tail -20 >&2
+    echo "sweep-scaling: the run with $n ranks failed" >&2
+    exit 1
+  fi
   end=$(date +%s.%N)
   wall=$(awk "BEGIN { print $end - $start }")
   jq -S 'del(.meta, .stats)' "$tmp/r$n.json" > "$tmp/s$n.json"
