@@ -52,14 +52,6 @@ int launcher_ranks() {
   return 1;
 }
 
-bool built_with_mpi() {
-#ifdef NHI_HAVE_MPI
-  return true;
-#else
-  return false;
-#endif
-}
-
 Cluster& Cluster::get() {
   static Cluster c;
   return c;

@@ -50,8 +50,6 @@ class Cluster {
   std::vector<int> leaders_{0};
 };
 
-// True when this build can run as several ranks (compiled with MPI).
-bool built_with_mpi();
 // The number of tasks an MPI launcher or srun says it started (1 without one).
 int launcher_ranks();
 

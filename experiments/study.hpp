@@ -204,16 +204,12 @@ inline RankStats& rank_stats() {
 // Owner rank of each cell: longest processing time first, over `ranks` (each
 // cell, by decreasing cost and then index, to the least loaded rank, ties to the
 // lowest).  Every rank computes the same table.
-inline std::vector<int> assign_cells(const Cells& c, const std::vector<int>& ranks) {
-  std::vector<double> cost(c.count);
-  std::vector<size_t> order(c.count);
-  for (size_t i = 0; i < c.count; ++i) {
-    cost[i] = c.cost(i);
-    order[i] = i;
-  }
+inline std::vector<int> assign_cells(const std::vector<double>& cost, const std::vector<int>& ranks) {
+  std::vector<size_t> order(cost.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cost[a] > cost[b]; });
   std::vector<double> load(ranks.size(), 0.0);
-  std::vector<int> owner(c.count, ranks.front());
+  std::vector<int> owner(cost.size(), ranks.front());
   for (const size_t i : order) {
     const size_t r = static_cast<size_t>(std::min_element(load.begin(), load.end()) - load.begin());
     owner[i] = ranks[r];
@@ -248,14 +244,14 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
   } else {
     for (int r = 0; r < cl.size(); ++r) ranks.push_back(r);
   }
-  const std::vector<int> owner = assign_cells(c, ranks);
+  std::vector<double> cost(c.count);
+  for (size_t i = 0; i < c.count; ++i) cost[i] = c.cost(i);
+  const std::vector<int> owner = assign_cells(cost, ranks);
   std::vector<size_t> mine;
   RankStats& st = rank_stats();
-  std::vector<double> cost(c.count);
   for (size_t i = 0; i < c.count; ++i)
     if (owner[i] == cl.rank()) {
       mine.push_back(i);
-      cost[i] = c.cost(i);
       st.estimated_cost += cost[i];
     }
   // Costliest first, so that the threads finish together.
