@@ -25,6 +25,7 @@
 // So the map on T*Q is not self-adjoint; MethodTraits says symmetric_in_phase = false.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -80,16 +81,16 @@ struct DlaStepProblem {
     Vec<T, n> D1;
     discrete_lagrangian_slots<S, D, T>(sys, disc, h, q0, q1, &D1, nullptr);  // eq. 9 / 10
     Vec<double, m> cscale;
-    const Vec<T, m> wd = discrete_constraint<S, D, T>(sys, disc, h, q0, q1, &cscale);  // eq. 13 / 14
+    const Vec<T, m> wd = discrete_constraint<S, D, T>(sys, disc, h, q0, q1, terms ? &cscale : nullptr);  // eq. 13 / 14
     for (int i = 0; i < n; ++i) {
       T force = cst<T>(0.0);
-      double fscale = 0;
-      for (int a = 0; a < mc; ++a) {
-        force += scale(lambda[a], W_t(i, a));
-        fscale += std::abs(W_t(i, a) * value_of(lambda[a]));
-      }
+      for (int a = 0; a < mc; ++a) force += scale(lambda[a], W_t(i, a));
       (*r)[i] = cst<T>(p_curr[i]) + D1[i] - force;  // eq. 6, first line
-      if (terms) (*terms)[i] = std::abs(p_curr[i]) + std::abs(value_of(D1[i])) + fscale;
+      if (terms) {
+        double fscale = 0;
+        for (int a = 0; a < mc; ++a) fscale += std::abs(W_t(i, a) * value_of(lambda[a]));
+        (*terms)[i] = std::abs(p_curr[i]) + std::abs(value_of(D1[i])) + fscale;
+      }
     }
     for (int a = 0; a < m; ++a) {
       (*r)[n + a] = wd[a];  // eq. 6, second line
@@ -126,11 +127,12 @@ class DlaMap {
 
   // One DLA step from (q_curr, p_curr).  q_guess and lambda (in) are the
   // starting iterate; on success q_next, lambda and p_next hold the solution.
+  // check_guess: the guess may already solve the step (NewtonSolver::solve).
   StepSummary step(const VecN& q_curr, const VecN& p_curr, const VecN& q_guess, VecN* q_next,
-                   VecM* lambda, VecN* p_next) const {
+                   VecM* lambda, VecN* p_next, bool check_guess = false) const {
     const Problem prob(sys_, disc_, h_, q_curr, p_curr);
     VecN q1 = q_guess;
-    StepSummary s = NewtonSolver<Problem>(prob, options_).solve(&q1, lambda);
+    StepSummary s = NewtonSolver<Problem>(prob, options_).solve(&q1, lambda, check_guess);
     if (s.status == SolveStatus::kConverged) {
       *q_next = q1;
       discrete_lagrangian_slots<S, D, double>(sys_, disc_, h_, q_curr, *q_next, nullptr, p_next);
@@ -168,6 +170,11 @@ class DlaStepper {
  public:
   static constexpr int n = S::n, m = S::m;
   static constexpr int lag = 1;
+  // Fixed-point passes of the predictor (next_guess): at h = 0.2 on the
+  // paper's scenes the midpoint rule needs four for one Newton iteration per
+  // step, and the symmetric rule settles at its third (issue 13).
+  static constexpr int kPredictorPasses = 4;
+  static constexpr double kSettled = 4 * std::numeric_limits<double>::epsilon();
   using Map = DlaMap<S, D>;
   using VecN = Vec<double, n>;
   using VecM = typename Map::VecM;
@@ -204,7 +211,8 @@ class DlaStepper {
   StepSummary step(double h) {
     VecN guess, plain;
     VecM lambda_guess;
-    next_guess(h, &guess, &lambda_guess, true);
+    bool settled = false;
+    next_guess(h, &guess, &lambda_guess, kPredictorPasses, &settled);
     const bool predicted = one_direction(h);  // next_guess extrapolated lambda and refined q
     if (predicted) plain = extrapolation(h);
     const VecM lambda_plain = lambda_;
@@ -218,7 +226,7 @@ class DlaStepper {
     h_prev_ = h_;
     h_ = h;
     map_.set_h(h);
-    StepSummary st = map_.step(q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_);
+    StepSummary st = map_.step(q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_, settled);
     if (!st.ok() && predicted) {
       // A large step can start outside Newton's basin from the predictor
       // (the sleigh at h = 2): retry from the plain start, the linear
@@ -244,18 +252,31 @@ class DlaStepper {
   // The starting iterate of the next step, of size h, from the newest point
   // (q_{k+1}, p_{k+1}) (issue 13).  First step: q_0 + h v_0 and lambda = 0;
   // second step, or a change of direction: the linear extrapolation of q and
-  // the last multipliers.  Then the multipliers, which carry the factor h (L_d does), extrapolate
-  // lambda_j / h_j linearly in t from the last two steps, and q from the linear
-  // extrapolation q_{k+1} + (h / h_k)(q_{k+1} - q_k) refined, when `refine`, by
-  // one fixed-point pass of eq. (6), first line: with the nodes q_c and the
-  // velocity inside dL/dq frozen at the extrapolation,
+  // the last multipliers.  Otherwise the multipliers, which carry the factor h
+  // (L_d does), extrapolate lambda_j / h_j linearly in t from the last two
+  // steps, q starts from the linear extrapolation q_{k+1} + (h / h_k)(q_{k+1} - q_k),
+  // and up to `passes` fixed-point passes of eq. (6) follow.  A pass freezes the
+  // nodes q_c and the velocity inside dL/dq at the current guess and solves
   //     sum_c w_c dL/dqdot(q_c, v) = p_{k+1} - omega(q_{k+1})^T lambda
-  //                                  + h sum_c w_c (1 - c) dL/dq(q_c, v_guess),
-  // solved for v with V(q_cbar, .) (hamiltonian.hpp; exact for a constant mass
-  // matrix; cbar = sum_c w_c c).  For a separable L its error is O(h^4), the
-  // extrapolation's O(h^2) (tests/test_dla.cpp).  A non-finite refinement
-  // keeps the extrapolation.
-  void next_guess(double h, VecN* q_guess, VecM* lambda_guess, bool refine) const {
+  //                                  + h sum_c w_c (1 - c) dL/dq(q_c, v_guess)   (eq. 6, first line)
+  // for v with V(q_cbar, .) (hamiltonian.hpp; exact for a constant mass
+  // matrix; cbar = sum_c w_c c); on a separable system with no holonomic
+  // constraint it first takes the multipliers from eq. (6), second line, with
+  // the constraint nodes frozen too: V is linear in p, so
+  //     Omega V(q_cbar, rhs - W^T lambda) = 0,  Omega = sum_c w_c omega(q_c),
+  // is m linear equations in lambda (rhs: the right side above without the
+  // force).  A pass moves the guess by O(h) times the guess's error (the nodes
+  // move the equations by h dL/dq and by omega(q_c) v), so each one gains an
+  // order of h (tests/test_dla.cpp).  A pass that moves no coordinate by more
+  // than 4 eps of its size is a fixed point of eq. (6): *settled says so, and
+  // the solve then starts with a residual check (NewtonSolver::solve).  This
+  // happens for the symmetric discretization (alpha = 0) on the separable scenes whose
+  // constraint rows read only coordinates the constraint force does not move
+  // (the paper's, the contact and chaotic oscillators): there the first pass
+  // is exact in those coordinates and the second in all.  A non-finite pass
+  // keeps the guess before it.
+  void next_guess(double h, VecN* q_guess, VecM* lambda_guess, int passes, bool* settled = nullptr) const {
+    if (settled) *settled = false;
     if (steps_ == 0) {
       *q_guess = q_curr_ + h * v0_;
       lambda_guess->setZero();
@@ -267,20 +288,43 @@ class DlaStepper {
       return;
     }
     *lambda_guess = h * (lambda_ / h_ + (h_ / h_prev_) * (lambda_ / h_ - lambda_prev_ / h_prev_));
-    if (!refine) return;
     const S& sys = map_.system();
+    const D& disc = map_.discretization();
     const VecN& q = q_next_;
-    const VecN vg = (*q_guess - q) / h;
-    VecN rhs = p_next_ - Map::Problem::force_forms(sys, q).transpose() * *lambda_guess;
+    const Mat<double, n, Map::mc> Wt = Map::Problem::force_forms(sys, q).transpose();
     double cbar = 0;
-    for (const Node& nd : map_.discretization().nodes()) {
-      VecN Lq, Lv;
-      lagrangian_partials(sys, VecN((1.0 - nd.c) * q + nd.c * *q_guess), vg, &Lq, &Lv);
-      rhs += (h * nd.weight * (1.0 - nd.c)) * Lq;
-      cbar += nd.weight * nd.c;
+    for (const Node& nd : disc.nodes()) cbar += nd.weight * nd.c;
+    // Without the multiplier solve the passes converge to a fixed point with
+    // the extrapolated multipliers, not to the step: one pass gets all there is.
+    if constexpr (!(Map::l == 0 && is_separable<S>::value)) passes = std::min(passes, 1);
+    for (int pass = 0; pass < passes; ++pass) {
+      const VecN vg = (*q_guess - q) / h;
+      VecN rhs = p_next_;
+      for (const Node& nd : disc.nodes()) {
+        VecN Lq, Lv;
+        lagrangian_partials(sys, VecN((1.0 - nd.c) * q + nd.c * *q_guess), vg, &Lq, &Lv);
+        rhs += (h * nd.weight * (1.0 - nd.c)) * Lq;
+      }
+      const VecN qbar = (1.0 - cbar) * q + cbar * *q_guess;
+      VecM lambda = *lambda_guess;
+      if constexpr (Map::l == 0 && is_separable<S>::value) {
+        Mat<double, m, n> Om = Mat<double, m, n>::Zero();
+        for (const Node& nd : disc.constraint_nodes())
+          Om += nd.weight * sys.template omega<double>(VecN((1.0 - nd.c) * q + nd.c * *q_guess));
+        Mat<double, m, m> A;
+        for (int a = 0; a < m; ++a) A.col(a) = Om * velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
+        lambda = A.inverse() * VecM(Om * velocity<S, double>(sys, qbar, rhs));
+      }
+      const VecN q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
+      if (!(q1.allFinite() && lambda.allFinite())) return;
+      const bool fixed = ((q1 - *q_guess).cwiseAbs() - kSettled * (q.cwiseAbs() + q1.cwiseAbs())).maxCoeff() <= 0;
+      *q_guess = q1;
+      *lambda_guess = lambda;
+      if (fixed) {
+        if (settled) *settled = true;
+        return;
+      }
     }
-    const VecN q1 = q + h * velocity<S, double>(sys, VecN((1.0 - cbar) * q + cbar * *q_guess), rhs);
-    if (q1.allFinite()) *q_guess = q1;
   }
 
   // The linear extrapolation q_{k+1} + (h / h_k)(q_{k+1} - q_k) (steps >= 1).
