@@ -170,10 +170,14 @@ class DlaStepper {
  public:
   static constexpr int n = S::n, m = S::m;
   static constexpr int lag = 1;
-  // Fixed-point passes of the predictor (next_guess): at h = 0.2 on the
-  // paper's scenes the midpoint rule needs four for one Newton iteration per
-  // step, and the symmetric rule settles at its third (issue 13).
-  static constexpr int kPredictorPasses = 4;
+  // Fixed-point passes of the predictor (next_guess).  A pass is a short
+  // chain of dependent operations, cheap in instructions but not in latency,
+  // so passes pay only where they end in a settled guess (no Jet evaluation
+  // and no iteration): the symmetric rule settles at its third on the
+  // structured scenes, and any rule at small h.  So a step makes up to
+  // kMaxPasses after a settled step (and every 8th step, to find out), else
+  // kMinPasses (issue 13; measured in the README).
+  static constexpr int kMaxPasses = 4, kMinPasses = 2;
   static constexpr double kSettled = 4 * std::numeric_limits<double>::epsilon();
   using Map = DlaMap<S, D>;
   using VecN = Vec<double, n>;
@@ -206,13 +210,15 @@ class DlaStepper {
     lambda_ = lambda_prev_ = VecM::Zero();
     steps_ = 0;
     h_prev_ = h_ = 0;
+    settled_ = true;
   }
 
   StepSummary step(double h) {
     VecN guess, plain;
     VecM lambda_guess;
     bool settled = false;
-    next_guess(h, &guess, &lambda_guess, kPredictorPasses, &settled);
+    next_guess(h, &guess, &lambda_guess, settled_ || steps_ % 8 == 0 ? kMaxPasses : kMinPasses, &settled);
+    settled_ = settled;
     const bool predicted = one_direction(h);  // next_guess extrapolated lambda and refined q
     if (predicted) plain = extrapolation(h);
     const VecM lambda_plain = lambda_;
@@ -297,8 +303,12 @@ class DlaStepper {
     // Without the multiplier solve the passes converge to a fixed point with
     // the extrapolated multipliers, not to the step: one pass gets all there is.
     if constexpr (!(Map::l == 0 && is_separable<S>::value)) passes = std::min(passes, 1);
+    // The passes only make a starting iterate (Newton or the check judges the
+    // result), so they multiply by 1/h: a division is the slowest link of
+    // their dependency chain.
+    const double inv_h = 1.0 / h;
     for (int pass = 0; pass < passes; ++pass) {
-      const VecN vg = (*q_guess - q) / h;
+      const VecN vg = (*q_guess - q) * inv_h;
       VecN rhs = p_next_;
       for (const Node& nd : disc.nodes()) {
         VecN Lq, Lv;
@@ -363,6 +373,7 @@ class DlaStepper {
   VecM lambda_ = VecM::Zero(), lambda_prev_ = VecM::Zero();
   long steps_ = 0;
   double h_ = 0, h_prev_ = 0;
+  bool settled_ = true;  // did the last step's predictor settle (next_guess)?
 };
 
 }  // namespace nhi
