@@ -51,9 +51,10 @@ struct ContactOscillatorNR {
   void partials(const Vec<T, 3>& q, const Vec<T, 3>& v, Vec<T, 3>* dLdq, Vec<T, 3>* dLdv) const {
     using std::cos;
     using std::sin;
+    const T c = cos(q[2]), s = sin(q[2]);  // one sincos call (robot.hpp)
     base().partials<T>(q, v, dLdq, dLdv);
-    (*dLdq)[2] += cos(q[2]) * v[2];
-    (*dLdv)[2] += sin(q[2]);
+    (*dLdq)[2] += c * v[2];
+    (*dLdv)[2] += s;
   }
 
   // V(q, p') = p' - (0, 0, sin z).

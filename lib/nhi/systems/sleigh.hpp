@@ -90,8 +90,9 @@ struct Sleigh {
   Mat<T, 1, 3> omega(const Vec<T, 3>& q) const {
     using std::cos;
     using std::sin;
+    const T s = sin(q[2]), c = cos(q[2]);  // one sincos call (robot.hpp)
     Mat<T, 1, 3> w;
-    w << -sin(q[2]), cos(q[2]), cst<T>(-a);
+    w << -s, c, cst<T>(-a);
     return w;
   }
 
