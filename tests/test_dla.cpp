@@ -100,8 +100,8 @@ TEST(DlaVariational, UnconstrainedDlaIsTheVariationalIntegratorInClosedForm) {
 // fitted log-log slope over h = 0.05 / 2^j, j = 0..3, for 0, 1 and 2 passes;
 // both discretizations the paper calls second order.  Where a pass count has
 // reached round-off at every h, there is no slope to fit and that is asserted
-// instead.  And the default passes leave the step within round-off of the
-// Newton solution from the plain start (the Fidelity of the fast path).
+// instead.  (That the default passes leave the step at round-off is
+// StepperFastPathSolvesTheStepToRoundOff below.)
 template <class S>
 class DlaPredictorTest : public ::testing::Test {};
 TYPED_TEST_SUITE(DlaPredictorTest, SeparableSystems);
