@@ -171,7 +171,7 @@ inline double step_weight(const nhi::MethodSpec& spec) {
   double w = 1.0;
   if (spec.kind == "dla") w = 6.0;
   else if (spec.kind == "mp06") w = 1.5;
-  else if (spec.kind == "discrete_gradient") w = 40.0;
+  else if (spec.kind == "discrete_gradient") w = 15.0;
   else if (spec.kind == "benchmark") w = 30.0;  // per output interval h
   const int stages = spec.kind == "benchmark" ? 1 : static_cast<int>(nhi::composition(spec.composition).gamma.size());
   return w * stages;

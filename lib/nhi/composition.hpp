@@ -100,6 +100,7 @@ class Composed {
       StepSummary s = inner_.step(c_.gamma[i] * h);
       total.iterations += s.iterations;
       total.evaluations += s.evaluations;
+      total.jacobians += s.jacobians;
       total.rhs_evaluations += s.rhs_evaluations;
       total.used_fallback = total.used_fallback || s.used_fallback;
       total.relative_residual = std::max(total.relative_residual, s.relative_residual);

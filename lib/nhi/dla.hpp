@@ -172,14 +172,20 @@ class DlaStepper {
   static constexpr int lag = 1;
   // Fixed-point passes of the predictor (next_guess).  A pass is a short
   // chain of dependent operations, cheap in instructions but not in latency,
-  // so passes pay only where they end in a settled guess (no Jet evaluation
-  // and no iteration): the symmetric rule settles at its third on the
-  // structured scenes, and any rule at small h.  So a step makes up to
-  // kMaxPasses after a settled step (and every 8th step, to find out), else
-  // kMinPasses (issue 13; measured in the README).
+  // so passes pay only where they end in a guess the residual check accepts
+  // (no Jet evaluation and no iteration): the symmetric rule's settles at its
+  // second pass on the structured scenes (the third only confirms it), and
+  // any rule's at small h.  So a step whose predecessor's guess was accepted
+  // makes kMinPasses and goes straight to the check (the check, not a third
+  // pass, confirms it); otherwise it makes kMinPasses, or kMaxPasses on every
+  // 8th step to find out, and is checked only if a pass moved nothing
+  // (issue 13; measured in the README).
   static constexpr int kMaxPasses = 4, kMinPasses = 2;
   static constexpr double kSettled = 4 * std::numeric_limits<double>::epsilon();
   using Map = DlaMap<S, D>;
+  // Do the passes solve for the multipliers too (next_guess)?  Needs V linear
+  // in p (a separable system) and no holonomic constraint.
+  static constexpr bool kPassesSolveMultipliers = Map::l == 0 && is_separable<S>::value;
   using VecN = Vec<double, n>;
   using VecM = typename Map::VecM;
 
@@ -210,15 +216,15 @@ class DlaStepper {
     lambda_ = lambda_prev_ = VecM::Zero();
     steps_ = 0;
     h_prev_ = h_ = 0;
-    settled_ = true;
+    accepted_ = false;
   }
 
   StepSummary step(double h) {
     VecN guess, plain;
     VecM lambda_guess;
     bool settled = false;
-    next_guess(h, &guess, &lambda_guess, settled_ || steps_ % 8 == 0 ? kMaxPasses : kMinPasses, &settled);
-    settled_ = settled;
+    const bool accepted_last = accepted_;
+    next_guess(h, &guess, &lambda_guess, accepted_last || steps_ % 8 != 0 ? kMinPasses : kMaxPasses, &settled);
     const bool predicted = one_direction(h);  // next_guess extrapolated lambda and refined q
     if (predicted) plain = extrapolation(h);
     const VecM lambda_plain = lambda_;
@@ -232,7 +238,11 @@ class DlaStepper {
     h_prev_ = h_;
     h_ = h;
     map_.set_h(h);
-    StepSummary st = map_.step(q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_, settled);
+    // (Only a guess the passes refined is worth the check: the stages of a
+    // composition that turn back get the plain extrapolation.)
+    const bool check = settled || (accepted_last && predicted);
+    StepSummary st = map_.step(q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_, check);
+    accepted_ = st.ok() && st.jacobians == 0;  // the residual check took the guess
     if (!st.ok() && predicted) {
       // A large step can start outside Newton's basin from the predictor
       // (the sleigh at h = 2): retry from the plain start, the linear
@@ -241,6 +251,7 @@ class DlaStepper {
       StepSummary retry = map_.step(q_curr_, p_curr_, plain, &q_next_, &lambda_, &p_next_);
       retry.iterations += st.iterations;
       retry.evaluations += st.evaluations;
+      retry.jacobians += st.jacobians;
       retry.used_fallback = true;  // counted as a fallback step (RunReport::fallbacks)
       if (!retry.ok()) retry.message = "from the predictor: " + st.message + "; from the extrapolation: " + retry.message;
       st = retry;
@@ -302,7 +313,7 @@ class DlaStepper {
     for (const Node& nd : disc.nodes()) cbar += nd.weight * nd.c;
     // Without the multiplier solve the passes converge to a fixed point with
     // the extrapolated multipliers, not to the step: one pass gets all there is.
-    if constexpr (!(Map::l == 0 && is_separable<S>::value)) passes = std::min(passes, 1);
+    if constexpr (!kPassesSolveMultipliers) passes = std::min(passes, 1);
     // The passes only make a starting iterate (Newton or the check judges the
     // result), so they multiply by 1/h: a division is the slowest link of
     // their dependency chain.
@@ -317,7 +328,7 @@ class DlaStepper {
       }
       const VecN qbar = (1.0 - cbar) * q + cbar * *q_guess;
       VecM lambda = *lambda_guess;
-      if constexpr (Map::l == 0 && is_separable<S>::value) {
+      if constexpr (kPassesSolveMultipliers) {
         Mat<double, m, n> Om = Mat<double, m, n>::Zero();
         for (const Node& nd : disc.constraint_nodes())
           Om += nd.weight * sys.template omega<double>(VecN((1.0 - nd.c) * q + nd.c * *q_guess));
@@ -373,7 +384,7 @@ class DlaStepper {
   VecM lambda_ = VecM::Zero(), lambda_prev_ = VecM::Zero();
   long steps_ = 0;
   double h_ = 0, h_prev_ = 0;
-  bool settled_ = true;  // did the last step's predictor settle (next_guess)?
+  bool accepted_ = false;  // did the residual check accept the last step's guess?
 };
 
 }  // namespace nhi

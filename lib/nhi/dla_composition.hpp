@@ -58,6 +58,7 @@ class ComposedDla {
       StepSummary s = dla_.step(c_.gamma[i] * h);
       total.iterations += s.iterations;
       total.evaluations += s.evaluations;
+      total.jacobians += s.jacobians;
       total.used_fallback = total.used_fallback || s.used_fallback;
       total.relative_residual = std::max(total.relative_residual, s.relative_residual);
       if (!s.ok()) {

@@ -70,6 +70,7 @@ class NewtonSolver {
       Summary f = tiny_solver(y, lambda);
       f.iterations += s.iterations;
       f.evaluations += s.evaluations;
+      f.jacobians += s.jacobians;
       f.used_fallback = true;
       if (f.status != SolveStatus::kConverged) {
         f.message = "Newton: " + s.message + "; TinySolver fallback: " + f.message;
@@ -135,20 +136,61 @@ class NewtonSolver {
     return rel;
   }
 
-  // Is (y, lambda) a solution at round-off, judged against the sizes of the
-  // terms alone?  Without the Jacobian part the scale is smaller, so this
-  // accepts only what newton() would accept at its first test (rel <= 16 eps),
-  // at the cost of one residual instead of one residual with derivatives.
+  // Is (y, lambda) a solution at round-off by newton()'s first test
+  // (rel <= 16 eps), without derivatives?  First against the sizes of the
+  // terms alone: a smaller scale than newton()'s, so what passes, newton()
+  // would accept unchanged.  At small h that scale is too small: the
+  // round-off of (q1 - q0)/h grows like 1/h, and newton() sees it in the
+  // Jacobian part of its scale, sum_j |dr_i/dy_j| y_scale_j.  A guess that
+  // fails gets a second test with half a lower bound of that part, from
+  // residuals at y + d, d_j = +-delta y_scale_j:
+  //     |r_i(y + d) - r_i(y)| / delta = |sum_j +-dr_i/dy_j y_scale_j| + O(delta)
+  //                                  <= sum_j |dr_i/dy_j| y_scale_j
+  // for any signs.  With delta = 2^-20 the O(delta) curvature and the
+  // 2 eps / delta of round-off in the difference are far inside the factor
+  // 1/2, so this too accepts only what newton() would.  One probe along
+  // +y_scale serves the rows of f (for the DLA, ~ -M/h); a row of g that still
+  // fails gets one along the signs of its multiplier's column of Wt (for the
+  // DLA, d omega_d/dq1 ~ omega/h and Wt = omega(q_k)^T), which do not cancel.
+  // (Issue 13: at h = 0.4 / 2^9 the first test failed on 99-100 % of the
+  // symmetric DLA's steps, and each then paid a Jet evaluation for zero
+  // iterations.)
   bool guess_converged(const VecY& y, const VecL& lambda, Summary* s) const {
     constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
+    constexpr double kDelta = 1.0 / (1 << 20);
     VecX r, terms;
     p_.template residual<double>(y, lambda, &r, &terms);
     double rel = 0;
     for (int i = 0; i < N; ++i) rel = std::max(rel, ratio(r[i], terms[i]));
+    int evaluations = 1;
+    if (!(rel <= kRoundoff)) {
+      // Probe 0 along +y_scale; for the rows of g, which can cancel along it,
+      // one probe per failing row with the signs of its multiplier's column of
+      // Wt (the DLA's d omega_d / dq1 is omega / h, and Wt = omega(q_k)^T).
+      const VecY ys = p_.y_scale(y);
+      VecX rd, bound = VecX::Zero();
+      for (int probe = 0; probe <= nl; ++probe) {
+        VecY d = kDelta * ys;
+        if (probe > 0) {
+          const int row = ny + probe - 1;
+          if (ratio(r[row], terms[row] + (0.5 / kDelta) * bound[row]) <= kRoundoff) continue;
+          for (int j = 0; j < ny; ++j)
+            if (p_.Wt()(j, probe - 1) < 0) d[j] = -d[j];
+        }
+        ++evaluations;
+        p_.template residual<double>(VecY(y + d), lambda, &rd, nullptr);
+        for (int i = 0; i < N; ++i) bound[i] = std::max(bound[i], std::abs(rd[i] - r[i]));
+        if (probe == 0)
+          for (int i = 0; i < ny; ++i)  // rows of f: no later probe is for them
+            if (!(ratio(r[i], terms[i] + (0.5 / kDelta) * bound[i]) <= kRoundoff)) return false;
+      }
+      rel = 0;
+      for (int i = 0; i < N; ++i) rel = std::max(rel, ratio(r[i], terms[i] + (0.5 / kDelta) * bound[i]));
+    }
     if (!(rel <= kRoundoff && rel <= options_.tolerance)) return false;
     s->status = SolveStatus::kConverged;
     s->iterations = 0;
-    s->evaluations = 1;
+    s->evaluations = evaluations;
     s->relative_residual = rel;
     return true;
   }
@@ -237,6 +279,7 @@ class NewtonSolver {
     VecX scale;  // of the rows, at the point of the last Jacobian
     double rel = evaluate(y, lambda, &r, &Jy, &scale);
     ++s.evaluations;
+    ++s.jacobians;
     for (int it = 0;; ++it) {
       s.relative_residual = rel;
       if (!std::isfinite(rel)) {
@@ -269,6 +312,7 @@ class NewtonSolver {
       if (!(rel <= options_.refresh_ratio * prev) && !(rel <= kRoundoff)) {  // slow contraction: refresh the Jacobian
         rel = evaluate(y, lambda, &r, &Jy, &scale);
         ++s.evaluations;
+        ++s.jacobians;
         fresh = true;
       }
     }
@@ -311,6 +355,7 @@ class NewtonSolver {
     const auto& summary = solver.Solve(cost, &x);
     s.iterations = summary.iterations;
     s.evaluations = summary.iterations + 1;
+    s.jacobians = s.evaluations;  // TinySolver differentiates at every evaluation
     const VecY y = x.template head<ny>();
     const VecL lambda = x.template tail<nl>();
     VecX r;

@@ -52,6 +52,7 @@ struct StepSummary {
   FailureKind failure = FailureKind::kNone;  // when failed
   int iterations = 0;            // Newton iterations (plus the fallback's, if it ran)
   int evaluations = 0;           // residual(+Jacobian) evaluations
+  int jacobians = 0;             // of those, the ones with derivatives (Jets)
   double relative_residual = 0;  // final max_i |r_i| / size of the terms of r_i
   bool used_fallback = false;
   long rhs_evaluations = 0;      // explicit methods and the reference solution
