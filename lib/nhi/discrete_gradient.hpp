@@ -59,22 +59,25 @@ struct DiscreteGradientProblem {
   // taken at the size of its numerator's terms, |H1| + |H0| + |grad H . dz|
   // (over |dz|^2): the correction's rounding, which sets the floor of every
   // row that contains it (when the velocities in a constraint row vanish
-  // together, it is all that is left of that row's size).
+  // together, it is all that is left of that row's size).  *c_out (may be
+  // null) gets Gonzalez's coefficient c (0 when dz = 0).
   template <class T>
   void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp,
-                         VecN* sq = nullptr, VecN* sp = nullptr) const {
+                         VecN* sq = nullptr, VecN* sp = nullptr, T* c_out = nullptr) const {
     const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1), pb = cst<T>(0.5) * (p0.template cast<T>() + p1);
     const Vec<T, n> gq = -force(sys, qb, pb), gp = velocity(sys, qb, pb);
     const Vec<T, n> dq = q1 - q0.template cast<T>(), dp = p1 - p0.template cast<T>();
     const T den = dq.squaredNorm() + dp.squaredNorm();
     *Dq = gq;
     *Dp = gp;
+    if (c_out) *c_out = cst<T>(0.0);
     double cs = 0;
     if (value_of(den) > 0) {  // Gonzalez's correction along dz (eq. 3.6)
       const T H1 = hamiltonian(sys, q1, p1);
       const T c = (H1 - cst<T>(H0) - gq.dot(dq) - gp.dot(dp)) / den;
       *Dq += c * dq;
       *Dp += c * dp;
+      if (c_out) *c_out = c;
       double num = std::abs(value_of(H1)) + std::abs(H0);
       for (int i = 0; i < n; ++i)
         num += std::abs(value_of(gq[i]) * value_of(dq[i])) + std::abs(value_of(gp[i]) * value_of(dp[i]));
@@ -214,17 +217,12 @@ class DiscreteGradientStepper {
     const double size = 1 + q0.cwiseAbs().maxCoeff() + p0.cwiseAbs().maxCoeff();
     double last_move = std::numeric_limits<double>::infinity();
     for (int pass = 0; pass < kPasses; ++pass) {
-      const VecN qb = 0.5 * (q0 + q1), pb = 0.5 * (p0 + p1);
-      const VecN gq = -force<S, double>(sys_, qb, pb), gp = velocity<S, double>(sys_, qb, pb);
-      const VecN dq = q1 - q0, dp = p1 - p0;
-      const double den = dq.squaredNorm() + dp.squaredNorm();
-      double c = 0, cs = 0;  // Gonzalez's c, and the size of its numerator's terms over den
-      if (den > 0) {
-        const double H1 = hamiltonian<S, double>(sys_, q1, p1);
-        c = (H1 - prob.H0 - gq.dot(dq) - gp.dot(dp)) / den;
-        cs = (std::abs(H1) + std::abs(prob.H0) + gq.cwiseProduct(dq).cwiseAbs().sum() + gp.cwiseProduct(dp).cwiseAbs().sum()) / den;
-      }
-      const VecN Dq = gq + c * dq, cp = c * dp;
+      // Dq = -F(qbar) + c dq and the frozen c dp, with the sizes sq, sp of
+      // the residual's rows (DiscreteGradientProblem::discrete_gradient).
+      VecN Dq, Dp, sq, sp;
+      double c = 0;
+      prob.template discrete_gradient<double>(q1, p1, &Dq, &Dp, &sq, &sp, &c);
+      const VecN qb = 0.5 * (q0 + q1), cp = c * (p1 - p0);
       const Mat<double, m, n> W = sys_.template omega<double>(qb);
       VecM l = VecM::Zero();
       if constexpr (m > 0) {
@@ -238,7 +236,6 @@ class DiscreteGradientStepper {
       const double move = std::max((q1n - q1).cwiseAbs().maxCoeff(), (p1n - p1).cwiseAbs().maxCoeff());
       // Settled: no component moved by more than 4 eps of the terms that make
       // it (those of the residual's rows, DiscreteGradientProblem::residual).
-      const VecN sq = gq.cwiseAbs() + cs * dq.cwiseAbs(), sp = gp.cwiseAbs() + cs * dp.cwiseAbs();
       const VecN fs = W.cwiseAbs().transpose() * l.cwiseAbs();
       const bool fixed =
           ((q1n - q1).cwiseAbs() - kSettled * (q0.cwiseAbs() + q1n.cwiseAbs() + std::abs(h) * sp)).maxCoeff() <= 0 &&
