@@ -264,13 +264,19 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
   Progress progress(label, static_cast<long>(mine.size()));
   const auto t0 = std::chrono::steady_clock::now();
   const long fail_cell = fault_cell("NHI_STUDY_FAIL_CELL"), kill_cell = fault_cell("NHI_STUDY_KILL_CELL");
+  // NHI_STUDY_CELL_TIMES=1: each cell's wall seconds on stderr (where a study spends its time).
+  const bool cell_times = std::getenv("NHI_STUDY_CELL_TIMES") != nullptr;
   parallel_for(mine.size(), o.threads, [&](size_t k) {
     if (failed.load()) return;
     const size_t i = mine[k];
     try {
       if (static_cast<long>(i) == kill_cell) std::raise(SIGKILL);
       if (static_cast<long>(i) == fail_cell) throw std::runtime_error("injected failure (NHI_STUDY_FAIL_CELL)");
+      const auto c0 = std::chrono::steady_clock::now();
       out[i] = c.run(i);
+      if (cell_times)
+        std::fprintf(stderr, "%s: cell %zu (%s): %.3f s\n", c.label.c_str(), i, c.name(i).c_str(),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count());
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(m);
       errors.emplace_back(i, e.what());

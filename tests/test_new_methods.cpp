@@ -138,7 +138,9 @@ TYPED_TEST(SeparableTest, DiscreteGradientPassesSolveTheStep) {
   using St = DiscreteGradientStepper<S>;
   using P = typename St::Problem;
   const S sys = make_system<S>();
-  for (double h : {0.2, 0.02, 0.4 / 512}) {
+  // h = 0.4 and the backward stage of a composition: there the passes
+  // contract slowly, get mixed (DiscreteGradientStepper::passes) or give up.
+  for (double h : {0.4, 0.2, -0.3, 0.02, 0.4 / 512}) {
     St st(sys);
     st.start(S::default_q0(), S::default_v0());
     const long steps = 400;
@@ -175,7 +177,7 @@ TYPED_TEST(SeparableTest, DiscreteGradientPassesSolveTheStep) {
     EXPECT_LE(worst_r, 64 * kEps) << S::name << " h " << h;
     EXPECT_LE(worst_dz, 1e-12) << S::name << " h " << h;
     EXPECT_LE(worst_impulse, 1e-12) << S::name << " h " << h;
-    if (h <= 0.02) EXPECT_GE(no_jacobian, 0.9 * steps) << S::name << " h " << h;
+    if (std::abs(h) <= 0.02) EXPECT_GE(no_jacobian, 0.9 * steps) << S::name << " h " << h;
   }
 }
 
