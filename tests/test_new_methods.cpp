@@ -129,9 +129,11 @@ TYPED_TEST(SeparableTest, Mp06ExplicitStepIsTheNewtonStep) {
 // stepper solves the step's equations to round-off by the full measure (the
 // scale with the Jacobian part) and is Newton's solution from the explicit
 // start to round-off of the state and of the constraint impulse.  At h = 0.02
-// and 0.4 / 2^9 the passes
-// contract by 1e-2 or better, so at least 90 % of the steps are taken with
-// no derivative evaluation.
+// and 0.4 / 2^9 the passes contract by 1e-2 or better, and at h = 0.2 by
+// 0.02-0.05 or, where one slow direction dominates (the sleigh, part of the
+// robot's steps), they are mixed: at h = 0.2 and below at least 90 % of the
+// steps are taken with no derivative evaluation (the sleigh's took one on
+// every step at h = 0.2 before the mixing).
 TYPED_TEST(SeparableTest, DiscreteGradientPassesSolveTheStep) {
   using S = TypeParam;
   constexpr int n = S::n;
@@ -177,7 +179,7 @@ TYPED_TEST(SeparableTest, DiscreteGradientPassesSolveTheStep) {
     EXPECT_LE(worst_r, 64 * kEps) << S::name << " h " << h;
     EXPECT_LE(worst_dz, 1e-12) << S::name << " h " << h;
     EXPECT_LE(worst_impulse, 1e-12) << S::name << " h " << h;
-    if (std::abs(h) <= 0.02) EXPECT_GE(no_jacobian, 0.9 * steps) << S::name << " h " << h;
+    if (h > 0 && h <= 0.2) EXPECT_GE(no_jacobian, 0.9 * steps) << S::name << " h " << h;
   }
 }
 

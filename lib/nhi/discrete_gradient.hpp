@@ -205,16 +205,20 @@ class DiscreteGradientStepper {
   // (lambda is set only to eps |H| / |dz|^2 through Gonzalez's c, and moves
   // p by h omega^T lambda; measured 5e-14 at h = 0.4 / 2^9 on the particle),
   // which the check judges.  Passes whose measured contraction predicts
-  // more than kMixBeyond in all are mixed (Anderson mixing, below).  Measured
-  // in one run (ns per step, without -> with the mixing): sleigh h = 0.2
-  // 3390 -> 970 (the passes used to run out and Newton took 4 iterations),
-  // robot h = 0.2 2660 -> 1640 (Newton iterations 0.64 -> 0.08 per step);
-  // h = 0.4: particle 3940 -> 2290, chaotic oscillator 6410 -> 3000, sleigh
-  // 4790 -> 1030; h = 0.2 elsewhere within the noise.
+  // that they will not settle within kPasses are mixed (Anderson mixing,
+  // below).  Measured in one run (ns per step, before the mixing and the
+  // early give-up -> with them, best of two): h = 0.4 particle 3670 -> 1390,
+  // chaotic oscillator 5700 -> 1650, sleigh 3850 -> 950, contact oscillator
+  // 1120 -> 750, robot 5400 -> 5220; h = 0.2 sleigh 2750 -> 970 (its passes
+  // used to run out, and Newton took 4 iterations), robot 2330 -> 1740
+  // (Newton iterations 0.64 -> 0.09 per step); h = 0.1 sleigh 1080 -> 750
+  // (12 -> 6 passes); elsewhere at h <= 0.2 the passes are (almost) never
+  // mixed and cost the same to the noise (+-7 %; the particle at h = 0.2
+  // +21 % in that run with the same 9.04 passes per step).
   // False when a pass contracts by less than 1/2
   // above that (diverging: Newton takes over from the explicit start), when
   // the mixed passes still predict more than kPasses in all, or after kPasses.
-  static constexpr int kPasses = 12, kMixBeyond = 8;
+  static constexpr int kPasses = 12, kPredict = 3;
   static constexpr double kSettled = 4 * std::numeric_limits<double>::epsilon();
   static constexpr double kStall = 1e-10;
   static constexpr double kMaxGamma = 4;
@@ -250,27 +254,40 @@ class DiscreteGradientStepper {
       // Settled: no component moved by more than 4 eps of the terms that make
       // it (those of the residual's rows, DiscreteGradientProblem::residual).
       const VecN fs = W.cwiseAbs().transpose() * l.cwiseAbs();
-      const bool fixed =
-          ((q1n - q1).cwiseAbs() - kSettled * (q0.cwiseAbs() + q1n.cwiseAbs() + std::abs(h) * sp)).maxCoeff() <= 0 &&
-          ((p1n - p1).cwiseAbs() - kSettled * (p0.cwiseAbs() + p1n.cwiseAbs() + std::abs(h) * (sq + fs))).maxCoeff() <= 0;
+      const VecN bound_q = kSettled * (q0.cwiseAbs() + q1n.cwiseAbs() + std::abs(h) * sp),
+                 bound_p = kSettled * (p0.cwiseAbs() + p1n.cwiseAbs() + std::abs(h) * (sq + fs));
+      const bool fixed = ((q1n - q1).cwiseAbs() - bound_q).maxCoeff() <= 0 && ((p1n - p1).cwiseAbs() - bound_p).maxCoeff() <= 0;
       // No longer contracting: at round-off (the residual check judges) or diverging.
       if (!fixed && pass > 0 && !(move <= 0.5 * last_move)) return last_move <= kStall * size;
       // Passes still needed at the contraction r = move / last_move just
-      // measured: log(4 eps size / move) / log r.  More than are left
-      // (kPasses - pass - 1) iff 4 eps size / move < r^left, tested without
-      // logarithms (two per pass cost 10-15 % of a step at h = 0.2).  When
-      // they would take more than kMixBeyond passes in all, the passes are
-      // mixed from here on (below); if, two passes into the mixing, they
-      // still need more than kPasses, they give up (at h = 0.4
-      // the passes contract by only ~0.1-0.4 and would otherwise all run
-      // before Newton does: particle 2.1 -> 4.1 us per step).
-      if (!fixed && pass > 0 && move > kSettled * size && (mix_from < 0 || pass >= mix_from + 2)) {
+      // measured: log(1 / excess) / log r.  More than are left
+      // (kPasses - pass - 1) iff excess r^left > 1, tested without
+      // logarithms (two per pass cost 10-15 % of a step at h = 0.2).  Then
+      // the passes are mixed from here on (below).  The excess, not the move
+      // against the state's size: the sleigh's passes crawl in a component
+      // much smaller than the state, and against the state they looked as if
+      // they would make it, ran out, and Newton took 4 iterations (h = 0.2).
+      // If, two passes into the mixing, even the move against the state's
+      // size (4 eps size / move < r^left, the lenient test: a give-up costs
+      // a Newton solve, and at h = 0.4 mixed passes that fail the strict
+      // test often settle) predicts more than kPasses, they give up (at
+      // h = 0.4 unmixed passes contract by only ~0.1-0.4 and, without the
+      // give-up, all ran before Newton did: particle 2.1 -> 4.1 us per step).
+      // The test runs on the first kPredict passes and two passes into the
+      // mixing only: on every pass its divisions and powers cost 5-30 % of
+      // a step at h = 0.1-0.2, where it almost never fires.
+      if (!fixed && pass > 0 && (mix_from < 0 ? pass <= kPredict : pass == mix_from + 2)) {
         const double r = move / last_move;
         double r_left = 1;
-        for (int j = pass + 1; j < (mix_from < 0 ? kMixBeyond : kPasses); ++j) r_left *= r;
-        if (kSettled * size < move * r_left) {
-          if (mix_from >= 0) return false;
-          mix_from = pass;
+        for (int j = pass + 1; j < kPasses; ++j) r_left *= r;
+        if (mix_from < 0) {
+          // The excess: the largest move over its own bound (settled: <= 1).
+          constexpr double tiny = std::numeric_limits<double>::min();  // a zero bound: 0 / tiny = 0
+          const double excess = std::max((q1n - q1).cwiseAbs().cwiseQuotient(bound_q.cwiseMax(tiny)).maxCoeff(),
+                                         (p1n - p1).cwiseAbs().cwiseQuotient(bound_p.cwiseMax(tiny)).maxCoeff());
+          if (excess * r_left > 1) mix_from = pass;
+        } else if (move * r_left > kSettled * size) {
+          return false;
         }
       }
       last_move = move;
@@ -287,7 +304,9 @@ class DiscreteGradientStepper {
       // passes are mixed: the mixing puts dot products and a division on the
       // passes' dependency chain, and mixing every pass made the fast ones
       // slower (particle at h = 0.2: 680 -> 940 ns per step) although it
-      // saved 1.5 of their 9 passes.
+      // saved 1.5 of their 9 passes; mixing those predicted to need more
+      // than 8 cost the particle 660 -> 750 ns and the chaotic oscillator
+      // 800 -> 1340 ns at h = 0.2.
       if (mix_from < 0) {
         q1 = q1n;
         p1 = p1n;
