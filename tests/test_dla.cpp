@@ -150,7 +150,9 @@ TYPED_TEST(DlaPredictorTest, EachFixedPointPassGainsAnOrder) {
 // scale), and agrees with Newton from the plain extrapolation to round-off of
 // the coordinates.  Where the constraint rows read only coordinates the
 // constraint force does not move (the structure that makes mp06 explicit,
-// Mp06Stepper::explicit_structure), the symmetric rule's predictor settles:
+// Mp06Stepper::explicit_structure), the predictor of a rule whose passes see
+// the potential exactly settles (the symmetric rule alpha = 0 everywhere, and
+// on a quadratic potential every rule: DlaStepper::passes_exact_in_potential):
 // at least 90% of its steps take no Newton iteration, and as many are accepted
 // by the residual check without a Jet evaluation (NewtonSolver::solve; also at
 // small h, where the check needs the second test with the Jacobian part).
@@ -184,7 +186,7 @@ void expect_fast_path_exact(const D& disc, double h, long steps) {
   }
   EXPECT_LE(worst_r, 64 * kEps) << S::name << " " << disc.name() << " h " << h;
   EXPECT_LE(worst_dq, 1e-12) << S::name << " " << disc.name() << " h " << h;
-  if (std::string(D::kind) == "symmetric" && Mp06Stepper<S>::explicit_structure(sys)) {
+  if (st.passes_exact_in_potential() && Mp06Stepper<S>::explicit_structure(sys)) {
     EXPECT_GE(no_iteration, 0.9 * (steps - 3)) << S::name << " " << disc.name() << " h " << h;
     EXPECT_GE(no_jacobian, 0.9 * (steps - 3)) << S::name << " " << disc.name() << " h " << h;
   }
@@ -195,6 +197,26 @@ TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
     expect_fast_path_exact<TypeParam>(AlphaDiscretization{0.5}, h, 400);
     expect_fast_path_exact<TypeParam>(SymmetricDiscretization{0.0}, h, 400);
   }
+  // Interior nodes other than 1/2, and a large and a negative step.
+  for (double h : {0.4, -0.2}) {
+    expect_fast_path_exact<TypeParam>(AlphaDiscretization{0.5}, h, 400);
+    expect_fast_path_exact<TypeParam>(AlphaDiscretization{0.25}, h, 400);
+    expect_fast_path_exact<TypeParam>(SymmetricDiscretization{0.25}, h, 400);
+  }
+}
+
+// Which passes see the potential exactly: every rule on the particle (quadratic
+// potential), the rules without an interior node everywhere, and not the
+// midpoint rule on the robot (V0 sin psi) or the contact oscillator (quartic).
+// (The sleigh's potential is linear: dL/dq is constant, and its passes see it exactly.)
+TEST(DlaPredictor, PassesExactInThePotentialOnAQuadraticPotential) {
+  EXPECT_TRUE((DlaStepper<Particle, AlphaDiscretization>(Particle{}, {0.5}).passes_exact_in_potential()));
+  EXPECT_TRUE((DlaStepper<Particle, SymmetricDiscretization>(Particle{}, {0.25}).passes_exact_in_potential()));
+  EXPECT_TRUE((DlaStepper<Robot, SymmetricDiscretization>(Robot{}, {0.0}).passes_exact_in_potential()));
+  EXPECT_TRUE((DlaStepper<Robot, AlphaDiscretization>(Robot{}, {1.0}).passes_exact_in_potential()));
+  EXPECT_FALSE((DlaStepper<Robot, AlphaDiscretization>(Robot{}, {0.5}).passes_exact_in_potential()));
+  EXPECT_FALSE((DlaStepper<ContactOscillator, AlphaDiscretization>(ContactOscillator{}, {0.5}).passes_exact_in_potential()));
+  EXPECT_TRUE((DlaStepper<Sleigh, AlphaDiscretization>(Sleigh{}, {0.5}).passes_exact_in_potential()));
 }
 
 TEST(DlaTraits, MethodsKnowTheirOrder) {

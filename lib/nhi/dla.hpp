@@ -189,11 +189,43 @@ class DlaStepper {
   using VecN = Vec<double, n>;
   using VecM = typename Map::VecM;
 
-  DlaStepper(const S& sys, const D& disc, DlaOptions options = {}) : map_(sys, disc, 0.0, options) {}
+  DlaStepper(const S& sys, const D& disc, DlaOptions options = {}) : map_(sys, disc, 0.0, options) {
+    if constexpr (kPassesSolveMultipliers) {
+      // M^-1 (constant on a separable system) and kappa = sum_c w_c c (1 - c)
+      // for the curvature of the passes (next_guess).
+      for (int j = 0; j < n; ++j) Minv_.col(j) = velocity<S, double>(map_.system(), VecN::Zero(), VecN::Unit(j));
+      for (const Node& nd : map_.discretization().nodes()) kappa_ += nd.weight * nd.c * (1.0 - nd.c);
+      if (kappa_ != 0) {
+        // K = d(dL/dq)/dq at two unrelated states (one Jet evaluation each):
+        // the curvature of the passes is used only when they agree bit for
+        // bit (a quadratic potential) and are not zero.
+        Mat<double, n, n> K[2];
+        for (int probe = 0; probe < 2; ++probe) {
+          using J = ceres::Jet<double, n>;
+          Vec<J, n> qj, vj, Lq, Lv;
+          for (int i = 0; i < n; ++i) {
+            qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
+            vj[i] = J(-0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i);
+          }
+          lagrangian_partials(map_.system(), qj, vj, &Lq, &Lv);
+          for (int i = 0; i < n; ++i) K[probe].row(i) = Lq[i].v.transpose();
+        }
+        if (K[0].allFinite() && K[0] == K[1]) {
+          affine_potential_force_ = true;  // (K = 0: dL/dq does not depend on q, nothing to add)
+          if ((K[0].array() != 0.0).any()) K_ = K[0];
+        }
+      }
+    }
+  }
 
   const S& system() const { return map_.system(); }
   const D& discretization() const { return map_.discretization(); }
   const Map& map() const { return map_; }
+  // Do the passes (next_guess) see the potential exactly: at the known point
+  // only (kappa = 0, no interior node), or through P (a quadratic potential)?
+  // Then, where the constraint rows read only coordinates the constraint
+  // force does not move, they settle (tests/test_dla.cpp).
+  bool passes_exact_in_potential() const { return kPassesSolveMultipliers && (kappa_ == 0 || affine_potential_force_); }
 
   MethodTraits traits() const {
     MethodTraits t;
@@ -292,6 +324,25 @@ class DlaStepper {
   // (the paper's, the contact and chaotic oscillators): there the first pass
   // is exact in those coordinates and the second in all.  A non-finite pass
   // keeps the guess before it.
+  //   Rules with an interior node (kappa = sum_c w_c c (1 - c) > 0: alpha = 1/2,
+  // the paper's second-order rule) see q_guess in dL/dq too, and frozen there
+  // a pass gains only a factor ~ h^2 kappa |d^2 U| (the particle at h = 0.2:
+  // ~0.02), too little to settle in kMinPasses, so Newton took ~1.9
+  // iterations and a Jet evaluation per step.  Where dL/dq is affine in q (a
+  // quadratic potential: K = d(dL/dq)/dq is constant, found at construction),
+  //     dL/dq(q_c) = dL/dq(q_c,guess) + c K (q_next - q_guess),  q_next - q_guess = h (v - v_guess)
+  // exactly, and the first line of eq. (6) is
+  //     (M - h^2 kappa K) v = rhs - h^2 kappa K v_guess - omega(q_{k+1})^T lambda:
+  // the passes use P = (M - h^2 kappa K)^-1 (kept while h does not change)
+  // instead of V(qbar, .) = M^-1, and are then exact in the potential, so
+  // the particle's settle like the symmetric rule's (h = 0.2: Newton
+  // iterations 1.89 -> 0.004 per step).  At a fixed point the added terms
+  // cancel (v = v_guess): it is still the step's solution.  With a
+  // non-quadratic potential the same passes with K taken once per step (one
+  // Jet evaluation) contracted by only ~200 per pass on the robot and ~1e3 on
+  // the contact oscillator, did not settle in kMinPasses, and made the steps
+  // slower (robot 610 -> 720 ns, chaotic oscillator 850 -> 1430 ns): those
+  // systems keep the passes above, as do kappa = 0 and K = 0.
   void next_guess(double h, VecN* q_guess, VecM* lambda_guess, int passes, bool* settled = nullptr) const {
     if (settled) *settled = false;
     if (steps_ == 0) {
@@ -318,6 +369,31 @@ class DlaStepper {
     // result), so they multiply by 1/h: a division is the slowest link of
     // their dependency chain.
     const double inv_h = 1.0 / h;
+    // The curvature of the passes (see above): P = (M - h^2 kappa K)^-1, and
+    // hkK = h^2 kappa K for the right side.
+    Mat<double, n, Map::mc> PWt;
+    if constexpr (kPassesSolveMultipliers) {
+      // Only where a plain pass gains less than 10^6 (its factor is about
+      // rho = h^2 kappa |M^-1 K|): below, two plain passes reach round-off
+      // from the extrapolation and P would only cost (particle, midpoint
+      // rule: h = 0.4 / 2^9, rho = 3e-7, 190-215 ns per step either way;
+      // h = 0.4 / 2^8, rho = 1.2e-6, plain passes needed a Jet on 32 % of the
+      // steps, 284 -> 194 ns with P).
+      if (K_ && h != P_h_) {
+        P_h_ = h;
+        P_ok_ = false;
+        hkK_ = (h * h * kappa_) * *K_;
+        const Mat<double, n, n> MhkK = Minv_ * hkK_;
+        const Mat<double, n, n> G = Mat<double, n, n>::Identity() - MhkK;  // M^-1 (M - h^2 kappa K)
+        const double det = G.determinant();
+        if (MhkK.cwiseAbs().maxCoeff() >= 1e-6 && std::isfinite(det) && std::abs(det) > 0.5) {  // h^2 kappa K small against M
+          P_ = G.inverse() * Minv_;
+          P_ok_ = P_.allFinite();
+        }
+      }
+    }
+    const bool curved = K_ && P_ok_;
+    if (curved) PWt = P_ * Wt;
     for (int pass = 0; pass < passes; ++pass) {
       const VecN vg = (*q_guess - q) * inv_h;
       VecN rhs = p_next_;
@@ -328,15 +404,24 @@ class DlaStepper {
       }
       const VecN qbar = (1.0 - cbar) * q + cbar * *q_guess;
       VecM lambda = *lambda_guess;
+      VecN q1;
       if constexpr (kPassesSolveMultipliers) {
         Mat<double, m, n> Om = Mat<double, m, n>::Zero();
         for (const Node& nd : disc.constraint_nodes())
           Om += nd.weight * sys.template omega<double>(VecN((1.0 - nd.c) * q + nd.c * *q_guess));
-        Mat<double, m, m> A;
-        for (int a = 0; a < m; ++a) A.col(a) = Om * velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
-        lambda = A.inverse() * VecM(Om * velocity<S, double>(sys, qbar, rhs));
+        if (curved) {
+          const VecN Prhs = P_ * VecN(rhs - hkK_ * vg);
+          lambda = Mat<double, m, m>(Om * PWt).inverse() * VecM(Om * Prhs);
+          q1 = q + h * VecN(Prhs - PWt * lambda);
+        } else {
+          Mat<double, m, m> A;
+          for (int a = 0; a < m; ++a) A.col(a) = Om * velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
+          lambda = A.inverse() * VecM(Om * velocity<S, double>(sys, qbar, rhs));
+          q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
+        }
+      } else {
+        q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
       }
-      const VecN q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
       if (!(q1.allFinite() && lambda.allFinite())) return;
       const bool fixed = ((q1 - *q_guess).cwiseAbs() - kSettled * (q.cwiseAbs() + q1.cwiseAbs())).maxCoeff() <= 0;
       *q_guess = q1;
@@ -378,6 +463,16 @@ class DlaStepper {
  private:
   Map map_;
   std::optional<VecN> p0_;
+  // The curvature of the passes (next_guess): M^-1 on a separable system,
+  // kappa = sum_c w_c c (1 - c), K = d(dL/dq)/dq when constant, and
+  // P = (M - h^2 kappa K)^-1, hkK = h^2 kappa K for the step P_h_.
+  Mat<double, n, n> Minv_ = Mat<double, n, n>::Zero();
+  double kappa_ = 0;
+  bool affine_potential_force_ = false;  // dL/dq affine in q (K constant, maybe 0)
+  std::optional<Mat<double, n, n>> K_;   // K when constant and not 0
+  mutable Mat<double, n, n> P_ = Mat<double, n, n>::Zero(), hkK_ = Mat<double, n, n>::Zero();
+  mutable double P_h_ = 0;
+  mutable bool P_ok_ = false;
   // Set by start(); zero until then (so that an unstarted stepper copies cleanly).
   VecN q_prev_ = VecN::Zero(), q_curr_ = VecN::Zero(), q_next_ = VecN::Zero(), p_curr_ = VecN::Zero(),
        p_next_ = VecN::Zero(), v0_ = VecN::Zero();
