@@ -25,10 +25,6 @@
 #include <utility>
 #include <vector>
 
-#if defined(__SSE__)
-#include <xmmintrin.h>
-#endif
-
 #include "cluster.hpp"
 #include "nhi/fit.hpp"
 #include "nhi/composition.hpp"
@@ -50,33 +46,6 @@ struct Options {
   std::vector<std::string> only;  // registered scenes to run (empty: all)
 };
 
-// Subnormal numbers flushed to zero on the calling thread, in results and
-// inputs (SSE's MXCSR flags FTZ, bit 15, and DAZ, bit 6; AArch64's FPCR.FZ).
-// Every study thread runs this way (parse(), parallel_for()); the library,
-// the tests and `nhi run` keep IEEE gradual underflow.  Why: an x86 operation
-// on a subnormal takes a microcode assist of ~100 cycles, and the sleigh's
-// angular velocity decays through the subnormal range for good (by 1e-75
-// every 200 time units, below 2.2e-308 from t ~ 800).  From there every
-// method's step on the sleigh cost 10-20x more (RK4: 1.76 s for 10^6 steps
-// of the long-horizon study instead of ~0.1 s), so the timings measured the
-// hardware's underflow and not the method.  Only values below 2.2e-308
-// change (they become 0); results/ agrees with a run without it to 1e-9
-// (README, "How the studies are timed").  Returns what was set, for the
-// result's "floating_point".
-inline const char* flush_subnormals() {
-#if defined(__SSE__)
-  _mm_setcsr(_mm_getcsr() | 0x8040u);
-  return "subnormals flushed to zero (SSE MXCSR: flush-to-zero and denormals-are-zero)";
-#elif defined(__aarch64__)
-  unsigned long fpcr;
-  asm volatile("mrs %0, fpcr" : "=r"(fpcr));
-  asm volatile("msr fpcr, %0" : : "r"(fpcr | (1ul << 24)));
-  return "subnormals flushed to zero (AArch64 FPCR.FZ)";
-#else
-  return "IEEE gradual underflow (no flush-to-zero control on this target)";
-#endif
-}
-
 // The wall-clock start of the study (for stats.wall_seconds).
 inline std::chrono::steady_clock::time_point& start_time() {
   static std::chrono::steady_clock::time_point t = std::chrono::steady_clock::now();
@@ -97,7 +66,6 @@ inline void add_options(CLI::App& app, Options& o) {
 // interrupt handlers; exits on --help or a bad command line (every rank alike).
 inline void parse(CLI::App& app, int argc, char** argv) {
   start_time();
-  flush_subnormals();
   Cluster& cl = Cluster::get();
   try {
     app.parse(argc, argv);
@@ -173,7 +141,6 @@ inline void parallel_for(size_t count, int threads, const std::function<void(siz
                          Progress* progress = nullptr) {
   std::atomic<size_t> next{0};
   auto worker = [&] {
-    flush_subnormals();  // (a new thread may start with the default MXCSR)
     for (size_t i; (i = next++) < count;) {
       if (nhi::interrupt_flag().load()) return;
       task(i);
@@ -396,7 +363,6 @@ inline int finish(const Options& o, json result) {
     code = 130;
   } else if (cl.root()) {
     result["stats"] = stats;
-    result["floating_point"] = flush_subnormals();
     result["meta"] = nhi::meta();
     try {
       nhi::AtomicFile f(o.out);

@@ -137,24 +137,14 @@ class DiscreteGradientStepper {
 
   explicit DiscreteGradientStepper(const S& sys, SolverOptions options = {}) : sys_(sys), options_(options) {
     if constexpr (is_separable<S>::value) {
-      // K = dF/dq at two unrelated states (one Jet evaluation each): the
-      // passes are exact in the force only where these agree bit for bit (F
-      // affine in q: a quadratic potential) and are not zero (passes()).
-      Mat<double, n, n> K[2];
-      for (int probe = 0; probe < 2; ++probe) {
-        using J = ceres::Jet<double, n>;
-        Vec<J, n> qj, pj;
-        for (int i = 0; i < n; ++i) {
-          qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
-          pj[i] = J(-0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i);
+      // The passes are exact in the force where K = dF/dq is constant (F
+      // affine in q: a quadratic potential), with Q where K is not zero.
+      if (const auto K = constant_force_jacobian(sys_)) {
+        affine_force_ = true;
+        if ((K->array() != 0.0).any()) {
+          K_ = *K;
+          Minv_ = inverse_mass_matrix(sys_);
         }
-        const Vec<J, n> F = force<S, J>(sys_, qj, pj);
-        for (int i = 0; i < n; ++i) K[probe].row(i) = F[i].v.transpose();
-      }
-      affine_force_ = K[0].allFinite() && K[0] == K[1];  // (K = 0: F does not depend on q)
-      if (affine_force_ && (K[0].array() != 0.0).any()) {
-        K_ = K[0];
-        for (int j = 0; j < n; ++j) Minv_.col(j) = velocity<S, double>(sys_, VecN::Zero(), VecN::Unit(j));
       }
     }
   }

@@ -193,26 +193,14 @@ class DlaStepper {
     if constexpr (kPassesSolveMultipliers) {
       // M^-1 (constant on a separable system) and kappa = sum_c w_c c (1 - c)
       // for the curvature of the passes (next_guess).
-      for (int j = 0; j < n; ++j) Minv_.col(j) = velocity<S, double>(map_.system(), VecN::Zero(), VecN::Unit(j));
+      Minv_ = inverse_mass_matrix(map_.system());
       for (const Node& nd : map_.discretization().nodes()) kappa_ += nd.weight * nd.c * (1.0 - nd.c);
       if (kappa_ != 0) {
-        // K = d(dL/dq)/dq at two unrelated states (one Jet evaluation each):
-        // the curvature of the passes is used only when they agree bit for
-        // bit (a quadratic potential) and are not zero.
-        Mat<double, n, n> K[2];
-        for (int probe = 0; probe < 2; ++probe) {
-          using J = ceres::Jet<double, n>;
-          Vec<J, n> qj, vj, Lq, Lv;
-          for (int i = 0; i < n; ++i) {
-            qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
-            vj[i] = J(-0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i);
-          }
-          lagrangian_partials(map_.system(), qj, vj, &Lq, &Lv);
-          for (int i = 0; i < n; ++i) K[probe].row(i) = Lq[i].v.transpose();
-        }
-        if (K[0].allFinite() && K[0] == K[1]) {
-          affine_potential_force_ = true;  // (K = 0: dL/dq does not depend on q, nothing to add)
-          if ((K[0].array() != 0.0).any()) K_ = K[0];
+        // The curvature of the passes is used only where K is constant (a
+        // quadratic potential) and not zero (K = 0: nothing to add).
+        if (const auto K = constant_force_jacobian(map_.system())) {
+          affine_potential_force_ = true;
+          if ((K->array() != 0.0).any()) K_ = *K;
         }
       }
     }

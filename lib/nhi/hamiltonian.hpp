@@ -19,6 +19,7 @@
 #pragma once
 
 #include <Eigen/LU>
+#include <optional>
 #include <type_traits>
 #include <utility>
 
@@ -79,6 +80,39 @@ template <class S, class T>
 inline T hamiltonian(const S& sys, const Vec<T, S::n>& q, const Vec<T, S::n>& p) {
   const Vec<T, S::n> v = velocity(sys, q, p);
   return p.dot(v) - sys.template lagrangian<T>(q, v);
+}
+
+// M^-1 of a separable system (constant), column j = V(0, e_j).
+template <class S>
+inline Mat<double, S::n, S::n> inverse_mass_matrix(const S& sys) {
+  constexpr int n = S::n;
+  Mat<double, n, n> Minv;
+  for (int j = 0; j < n; ++j) Minv.col(j) = velocity<S, double>(sys, Vec<double, n>::Zero(), Vec<double, n>::Unit(j));
+  return Minv;
+}
+
+// K = d(dL/dq)/dq when it is the same bit for bit (by autodiff, one Jet
+// evaluation of the partials each) at two unrelated states: dL/dq affine in q,
+// a quadratic potential (K = 0: a linear one, or none).  nullopt otherwise.
+// On a separable system dL/dq does not depend on v, so K is also dF/dq.  The
+// predictor passes of the DLA and the discrete gradient are exact in the
+// potential with it (dla.hpp, discrete_gradient.hpp).
+template <class S>
+inline std::optional<Mat<double, S::n, S::n>> constant_force_jacobian(const S& sys) {
+  constexpr int n = S::n;
+  using J = ceres::Jet<double, n>;
+  Mat<double, n, n> K[2];
+  for (int probe = 0; probe < 2; ++probe) {
+    Vec<J, n> qj, vj, Lq, Lv;
+    for (int i = 0; i < n; ++i) {
+      qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
+      vj[i] = J(-0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i);
+    }
+    lagrangian_partials(sys, qj, vj, &Lq, &Lv);
+    for (int i = 0; i < n; ++i) K[probe].row(i) = Lq[i].v.transpose();
+  }
+  if (K[0].allFinite() && K[0] == K[1]) return K[0];
+  return std::nullopt;
 }
 
 }  // namespace nhi
