@@ -159,7 +159,7 @@ study-work-precision: results/step_costs.json
 
 # Micro-benchmarks: ns per step, and the DLA step over the analytic floor.
 results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
-	$< --benchmark_min_time=0.5 -o $@
+	$< --benchmark_min_time=0.2 --benchmark_repetitions=3 --benchmark_enable_random_interleaving=true -o $@
 
 # Markdown tables of the study results, quoted in README.md.
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
