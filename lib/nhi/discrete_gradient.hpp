@@ -221,7 +221,8 @@ class DiscreteGradientStepper {
   // particle the constraint row then reads a y that is exact after one pass,
   // and the passes settle in three (at h = 0.2, nine before; at h = 0.4 they
   // used to be mixed or give up on 19 % of the steps).  Settled, they hand
-  // over to the plain passes, which settle at once (below).  Returns true (settled: the solve starts with the residual
+  // over to the plain passes, which settle at once (below).
+  //   Returns true (settled: the solve starts with the residual
   // check, NewtonSolver::solve) when a pass moves no component by more than
   // 4 eps of the terms it is made of, or stops contracting (by 1/2) within
   // 1e-10 of the state's size: at round-off the iterates wander in a cloud
@@ -320,7 +321,6 @@ class DiscreteGradientStepper {
       const VecN bound_q = kSettled * (q0.cwiseAbs() + q1n.cwiseAbs() + std::abs(h) * sp),
                  bound_p = kSettled * (p0.cwiseAbs() + p1n.cwiseAbs() + std::abs(h) * (sq + fs));
       const bool fixed = ((q1n - q1).cwiseAbs() - bound_q).maxCoeff() <= 0 && ((p1n - p1).cwiseAbs() - bound_p).maxCoeff() <= 0;
-
       // No longer contracting: at round-off (the residual check judges) or diverging.
       if (!fixed && pass > 0 && !(move <= 0.5 * last_move)) {
         if (!(last_move <= kStall * size)) return false;
