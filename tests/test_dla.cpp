@@ -205,6 +205,66 @@ TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
   }
 }
 
+// A guess the residual check accepts is corrected from its residual
+// (DlaStepper::polish), so that what the stepper returns is the zero of the
+// residual rounded to the grid, not the passes' fixed point: one full Newton
+// correction (exact Jacobian, matrix 7) from each accepted q_{k+1} moves each
+// coordinate by half an ulp at most, at most eps |q|_inf / 2, so by
+// eps |q|_inf / 4 on average over steps; asserted: 0.3 eps |q|_inf.  The check
+// alone accepts up to 16 eps of its scale, and at small h that let through
+// offsets smooth from step to step: mean corrections of 0.94 (contact
+// oscillator, midpoint rule, h = 0.4 / 2^8), 2.0 (chaotic oscillator) and 1.03
+// (sleigh, h = 0.4 / 2^9) eps |q|_inf, and a drift of the mean energy error
+// (README, issue 13); with the correction at most 0.18.
+template <class S, class D>
+double mean_correction_of_accepted_steps(const D& disc, double h, long steps) {
+  constexpr int n = S::n;
+  using Problem = DlaStepProblem<S, D>;
+  constexpr int mc = Problem::mc, N = n + mc;
+  const S sys = make_system<S>();
+  Vec<double, n> q0, v0;
+  scene_state<S>(&q0, &v0);
+  DlaStepper<S, D> st(sys, disc);
+  st.start(q0, v0);
+  Vec<double, n> sum = Vec<double, n>::Zero();
+  long accepted = 0;
+  for (long k = 0; k < steps; ++k) {
+    const Vec<double, 2 * n> z = st.phase();
+    const Vec<double, n> q = z.template head<n>(), p = z.template tail<n>();
+    const StepSummary s = st.step(h);
+    EXPECT_TRUE(s.ok()) << S::name << " " << disc.name() << " h " << h << " step " << k << ": " << s.message;
+    if (!s.ok()) return std::numeric_limits<double>::infinity();
+    if (k < 3 || s.jacobians != 0) continue;  // Newton's steps, not the check's
+    const Vec<double, n> q1 = st.phase().template head<n>();
+    const Problem prob(sys, disc, h, q, p);
+    using J = ceres::Jet<double, n>;
+    Vec<J, n> yj;
+    for (int i = 0; i < n; ++i) yj[i] = J(q1[i], i);
+    Vec<J, N> rj;
+    prob.template residual<J>(yj, Vec<J, mc>(st.lambda().template cast<J>()), &rj, nullptr);
+    Mat<double, N, N> K = Mat<double, N, N>::Zero();
+    Vec<double, N> r;
+    for (int i = 0; i < N; ++i) {
+      r[i] = rj[i].a;
+      for (int j = 0; j < n; ++j) K(i, j) = rj[i].v[j];
+    }
+    K.template topRightCorner<n, mc>() = -prob.Wt();
+    const Vec<double, N> dx = K.partialPivLu().solve(r);
+    sum += dx.template head<n>().cwiseAbs() / (kEps * q1.cwiseAbs().maxCoeff());
+    ++accepted;
+  }
+  return accepted ? sum.maxCoeff() / accepted : 0.0;
+}
+
+TYPED_TEST(DlaTest, AcceptedGuessIsTheStepSolutionRounded) {
+  for (double h : {0.2, 0.02, 0.4 / 256, 0.4 / 512}) {
+    EXPECT_LE(mean_correction_of_accepted_steps<TypeParam>(AlphaDiscretization{0.5}, h, 10000), 0.3)
+        << "midpoint h " << h;
+    EXPECT_LE(mean_correction_of_accepted_steps<TypeParam>(SymmetricDiscretization{0.0}, h, 10000), 0.3)
+        << "symmetric h " << h;
+  }
+}
+
 // Which passes see the potential exactly: every rule on the particle (quadratic
 // potential), the rules without an interior node everywhere, and not the
 // midpoint rule on the robot (V0 sin psi) or the contact oscillator (quartic).

@@ -57,13 +57,28 @@ class NewtonSolver {
 
   explicit NewtonSolver(const P& problem, Options options = {}) : p_(problem), options_(options) {}
 
+  // No correction of an accepted guess (solve()).
+  struct NoPolish {
+    void operator()(const VecX&, VecY*, VecL*) const {}
+  };
+
   // Solve from (y, lambda) in place; on failure y and lambda keep the guess.
   // check_guess: the guess may already be a solution (a converged predictor,
-  // dla.hpp), so first test it with one residual and no derivatives.
-  Summary solve(VecY* y, VecL* lambda, bool check_guess = false) const {
+  // dla.hpp), so first test it with one residual and no derivatives.  A guess
+  // the test accepts then gets polish(r, &y, &lambda), r its residual: one
+  // correction toward the zero of the residual with an approximate inverse of
+  // the step matrix the caller has at hand (the DLA: its passes' matrices),
+  // since the test accepts a point up to 16 eps of its scale away, and a
+  // predictor's error is smooth from step to step (dla.hpp, DlaStepper::step).
+  template <class Polish = NoPolish>
+  Summary solve(VecY* y, VecL* lambda, bool check_guess = false, const Polish& polish = {}) const {
     if (check_guess) {
       Summary s;
-      if (guess_converged(*y, *lambda, &s)) return s;
+      VecX r;
+      if (guess_converged(*y, *lambda, &s, &r)) {
+        polish(r, y, lambda);
+        return s;
+      }
     }
     Summary s = newton(y, lambda);
     if (s.status != SolveStatus::kConverged && options_.fallback) {
@@ -155,7 +170,8 @@ class NewtonSolver {
   // (Issue 13: at h = 0.4 / 2^9 the first test failed on 99-100 % of the
   // symmetric DLA's steps, and each then paid a Jet evaluation for zero
   // iterations.)
-  bool guess_converged(const VecY& y, const VecL& lambda, Summary* s) const {
+  // *r_out (optional) gets the residual of an accepted guess.
+  bool guess_converged(const VecY& y, const VecL& lambda, Summary* s, VecX* r_out = nullptr) const {
     constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
     constexpr double kDelta = 1.0 / (1 << 20);
     VecX r, terms;
@@ -188,6 +204,7 @@ class NewtonSolver {
       for (int i = 0; i < N; ++i) rel = std::max(rel, ratio(r[i], terms[i] + (0.5 / kDelta) * bound[i]));
     }
     if (!(rel <= kRoundoff && rel <= options_.tolerance)) return false;
+    if (r_out) *r_out = r;
     s->status = SolveStatus::kConverged;
     s->iterations = 0;
     s->evaluations = evaluations;
