@@ -65,18 +65,21 @@ class NewtonSolver {
   // Solve from (y, lambda) in place; on failure y and lambda keep the guess.
   // check_guess: the guess may already be a solution (a converged predictor,
   // dla.hpp), so first test it with one residual and no derivatives.  A guess
-  // the test accepts then gets polish(r, &y, &lambda), r its residual: one
-  // correction toward the zero of the residual with an approximate inverse of
-  // the step matrix the caller has at hand (the DLA: its passes' matrices),
-  // since the test accepts a point up to 16 eps of its scale away, and a
-  // predictor's error is smooth from step to step (dla.hpp, DlaStepper::step).
+  // accepted by the second test (guess_converged: at small h, where the scale
+  // holds the round-off of (q1 - q0)/h) then gets polish(r, &y, &lambda), r its
+  // residual: one correction toward the zero of the residual with an
+  // approximate inverse of the step matrix the caller has at hand (the DLA:
+  // its passes' matrices), since that test accepts a point up to 16 eps of a
+  // scale ~|y|/h away, and a predictor's error is smooth from step to step
+  // (dla.hpp, DlaStepper::polish).
   template <class Polish = NoPolish>
   Summary solve(VecY* y, VecL* lambda, bool check_guess = false, const Polish& polish = {}) const {
     if (check_guess) {
       Summary s;
       VecX r;
-      if (guess_converged(*y, *lambda, &s, &r)) {
-        polish(r, y, lambda);
+      bool by_bound = false;
+      if (guess_converged(*y, *lambda, &s, &r, &by_bound)) {
+        if (by_bound) polish(r, y, lambda);
         return s;
       }
     }
@@ -170,8 +173,10 @@ class NewtonSolver {
   // (Issue 13: at h = 0.4 / 2^9 the first test failed on 99-100 % of the
   // symmetric DLA's steps, and each then paid a Jet evaluation for zero
   // iterations.)
-  // *r_out (optional) gets the residual of an accepted guess.
-  bool guess_converged(const VecY& y, const VecL& lambda, Summary* s, VecX* r_out = nullptr) const {
+  // *r_out (optional) gets the residual of an accepted guess, and *by_bound
+  // whether it took the second test.
+  bool guess_converged(const VecY& y, const VecL& lambda, Summary* s, VecX* r_out = nullptr,
+                       bool* by_bound = nullptr) const {
     constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
     constexpr double kDelta = 1.0 / (1 << 20);
     VecX r, terms;
@@ -179,7 +184,8 @@ class NewtonSolver {
     double rel = 0;
     for (int i = 0; i < N; ++i) rel = std::max(rel, ratio(r[i], terms[i]));
     int evaluations = 1;
-    if (!(rel <= kRoundoff)) {
+    const bool second = !(rel <= kRoundoff);
+    if (second) {
       // Probe 0 along +y_scale; for the rows of g, which can cancel along it,
       // one probe per failing row with the signs of its multiplier's column of
       // Wt (the DLA's d omega_d / dq1 is omega / h, and Wt = omega(q_k)^T).
@@ -205,6 +211,7 @@ class NewtonSolver {
     }
     if (!(rel <= kRoundoff && rel <= options_.tolerance)) return false;
     if (r_out) *r_out = r;
+    if (by_bound) *by_bound = second;
     s->status = SolveStatus::kConverged;
     s->iterations = 0;
     s->evaluations = evaluations;
