@@ -6,7 +6,8 @@ set terminal pngcairo size 1400,620 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 # Columns h, error of method i if its family is (want = 1) or is not (want = 0) "isolation".
 m(i, want) = sprintf("< jq -r '.scenes.%s.methods[%d] | select((.family == \"isolation\") == %s) | [.h, .error] | transpose[] | select(.[1] != null) | @tsv' %s", scene, i, want ? "true" : "false", file)
-label(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label) (p = \\(.fitted_order * 100 | round / 100))\"' %s", scene, i, file))
+# (fitted_order is null where no two errors above round-off remain: "p = -")
+label(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label) (p = \\(.fitted_order | if type == \"number\" then (. * 100 | round / 100) else \"-\" end))\"' %s", scene, i, file))
 family(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].family' %s", scene, i, file))
 # Line style of method i: 10 + its fixed style (plots/style.gp).
 sty(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
