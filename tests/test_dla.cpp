@@ -205,8 +205,9 @@ TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
   }
 }
 
-// A guess the residual check accepts is corrected from its residual
-// (DlaStepper::polish), so that what the stepper returns is the zero of the
+// A guess the residual check accepts by its second test (small h) is
+// corrected from its residual (DlaStepper::polish), so that what the
+// stepper returns (by either test) is the zero of the
 // residual rounded to the grid, not the passes' fixed point: one full Newton
 // correction (exact Jacobian, matrix 7) from each accepted q_{k+1} moves each
 // coordinate by half an ulp at most, at most eps |q|_inf / 2, so by
@@ -215,9 +216,12 @@ TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
 // offsets smooth from step to step: mean corrections of 0.94 (contact
 // oscillator, midpoint rule, h = 0.4 / 2^8), 2.0 (chaotic oscillator) and 1.03
 // (sleigh, h = 0.4 / 2^9) eps |q|_inf, and a drift of the mean energy error
-// (README, issue 13); with the correction at most 0.18.
+// (README, issue 13); with the correction at most 0.18.  *accepted_share
+// gets the share of steps the check accepted, so that the assertion is not
+// empty where it matters: at small h the passes of a separable scene reach
+// the check on at least 79 % of the steps (measured), asserted 50 %.
 template <class S, class D>
-double mean_correction_of_accepted_steps(const D& disc, double h, long steps) {
+double mean_correction_of_accepted_steps(const D& disc, double h, long steps, double* accepted_share) {
   constexpr int n = S::n;
   using Problem = DlaStepProblem<S, D>;
   constexpr int mc = Problem::mc, N = n + mc;
@@ -253,15 +257,22 @@ double mean_correction_of_accepted_steps(const D& disc, double h, long steps) {
     sum += dx.template head<n>().cwiseAbs() / (kEps * q1.cwiseAbs().maxCoeff());
     ++accepted;
   }
+  *accepted_share = accepted / double(steps - 3);
   return accepted ? sum.maxCoeff() / accepted : 0.0;
+}
+
+template <class S, class D>
+void expect_accepted_steps_rounded(const D& disc, double h) {
+  double share = 0;
+  EXPECT_LE(mean_correction_of_accepted_steps<S>(disc, h, 10000, &share), 0.3) << disc.name() << " h " << h;
+  if (DlaStepper<S, D>::kPassesSolveMultipliers && h < 0.01)
+    EXPECT_GE(share, 0.5) << disc.name() << " h " << h << ": the check was not reached";
 }
 
 TYPED_TEST(DlaTest, AcceptedGuessIsTheStepSolutionRounded) {
   for (double h : {0.2, 0.02, 0.4 / 256, 0.4 / 512}) {
-    EXPECT_LE(mean_correction_of_accepted_steps<TypeParam>(AlphaDiscretization{0.5}, h, 10000), 0.3)
-        << "midpoint h " << h;
-    EXPECT_LE(mean_correction_of_accepted_steps<TypeParam>(SymmetricDiscretization{0.0}, h, 10000), 0.3)
-        << "symmetric h " << h;
+    expect_accepted_steps_rounded<TypeParam>(AlphaDiscretization{0.5}, h);
+    expect_accepted_steps_rounded<TypeParam>(SymmetricDiscretization{0.0}, h);
   }
 }
 
