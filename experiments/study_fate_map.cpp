@@ -66,7 +66,7 @@ json run_cell(const Grid& g, size_t i) {
       const nhi::RunReport rep =
           nhi::run_method(sys, g.methods[m].spec, q0, v0, h, steps, [&](const nhi::Sample<S::n, S::m>& smp) {
             const double dE = std::abs(nhi::energy(sys, smp.q, smp.v) - E0);
-            if (!std::isfinite(dE) || !smp.q.allFinite()) {
+            if (!std::isfinite(dE) || !nhi::all_finite(smp.q)) {
               fate = 'n';
               return false;
             }

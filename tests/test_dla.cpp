@@ -192,6 +192,53 @@ void expect_fast_path_exact(const D& disc, double h, long steps) {
   }
 }
 
+// The stepper does not evaluate omega again at a constraint node whose
+// coordinates omega reads are the same bits (OmegaMemo, issue 13).  That is
+// right only if omega_reads() finds every coordinate omega depends on: here a
+// coordinate it leaves out never changes omega, one it lists does, and the
+// memo gives omega(q) bit for bit along a sequence of states in which the
+// unread coordinates move alone.
+TYPED_TEST(DlaTest, OmegaMemoIsOmegaBitForBit) {
+  using S = TypeParam;
+  constexpr int n = S::n, m = S::m;
+  std::mt19937 rng(20261202);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int trial = 0; trial < 4; ++trial) {
+    const S sys = trial == 0 ? make_system<S>() : randomized_system<S>(rng);
+    using Stepper = DlaStepper<S, AlphaDiscretization>;
+    typename Stepper::Map::Problem::Memo memo;
+    memo.reads = Stepper::omega_reads(sys);
+    for (int k = 0; k < 50; ++k) {
+      Vec<double, n> q, v;
+      random_state<S>(rng, &q, &v, sys);
+      const Mat<double, m, n> W = sys.template omega<double>(q);
+      EXPECT_TRUE((memo.at(sys, 0, q).array() == W.array()).all()) << S::name << " state " << k;
+      for (int j = 0; j < n; ++j) {
+        Vec<double, n> q2 = q;
+        q2[j] += u(rng);
+        const Mat<double, m, n> W2 = sys.template omega<double>(q2);
+        const bool same = (W2.array() == W.array()).all();
+        if (!memo.reads[j]) EXPECT_TRUE(same) << S::name << ": omega depends on q_" << j << ", not listed";
+        EXPECT_TRUE((memo.at(sys, 0, q2).array() == W2.array()).all()) << S::name << " state " << k << " q_" << j;
+        EXPECT_TRUE((memo.at(sys, 0, q).array() == W.array()).all()) << S::name << " state " << k << " back";
+      }
+    }
+    // Every listed coordinate changes omega somewhere (the list is not "all").
+    for (int j = 0; j < n; ++j) {
+      if (!memo.reads[j]) continue;
+      bool changed = false;
+      for (int k = 0; k < 20 && !changed; ++k) {
+        Vec<double, n> q, v;
+        random_state<S>(rng, &q, &v, sys);
+        Vec<double, n> q2 = q;
+        q2[j] += u(rng);
+        changed = !(sys.template omega<double>(q2).array() == sys.template omega<double>(q).array()).all();
+      }
+      EXPECT_TRUE(changed) << S::name << ": q_" << j << " listed but never changes omega";
+    }
+  }
+}
+
 TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
   for (double h : {0.2, 0.02, 0.4 / 512}) {
     expect_fast_path_exact<TypeParam>(AlphaDiscretization{0.5}, h, 400);

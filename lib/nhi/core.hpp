@@ -20,6 +20,17 @@ using Vec = Eigen::Matrix<T, N, 1>;
 template <class T, int R, int C>
 using Mat = Eigen::Matrix<T, R, C>;
 
+// Is every entry finite?  The same test as Eigen's allFinite(), which
+// computes (x - x) == (x - x) through an unrolled helper that GCC leaves out
+// of line: 10 % of a particle DLA step (issue 13, perf).
+template <class Derived>
+inline bool all_finite(const Eigen::DenseBase<Derived>& x) {
+  bool ok = true;
+  for (Eigen::Index j = 0; j < x.cols(); ++j)
+    for (Eigen::Index i = 0; i < x.rows(); ++i) ok &= std::isfinite(x.coeff(i, j));
+  return ok;
+}
+
 template <class T>
 struct is_jet : std::false_type {};
 template <class T, int N>

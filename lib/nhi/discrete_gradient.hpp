@@ -273,7 +273,7 @@ class DiscreteGradientStepper {
       if (hKM.cwiseAbs().maxCoeff() >= 5e-4 && std::isfinite(det) && std::abs(det) > 0.5) {  // (h^2/4) K small against M
         Q_ = G.inverse();
         MQ_ = Minv_ * Q_;
-        Q_ok_ = Q_.allFinite();
+        Q_ok_ = all_finite(Q_);
       }
     }
     const bool curved = allow_curved && K_ && Q_ok_;
@@ -313,7 +313,7 @@ class DiscreteGradientStepper {
         p1n = p0 - h * (Dq - W.transpose() * l);
         q1n = q0 + h * (velocity<S, double>(sys_, qb, VecN(0.5 * (p0 + p1n))) + cp);
       }
-      if (!(q1n.allFinite() && p1n.allFinite() && l.allFinite())) return false;
+      if (!(all_finite(q1n) && all_finite(p1n) && all_finite(l))) return false;
       const double move = std::max((q1n - q1).cwiseAbs().maxCoeff(), (p1n - p1).cwiseAbs().maxCoeff());
       // Settled: no component moved by more than 4 eps of the terms that make
       // it (those of the residual's rows, DiscreteGradientProblem::residual).
@@ -409,7 +409,7 @@ class DiscreteGradientStepper {
     VecM lambda = lambda_;
     StepSummary s = map(h, q_, p_, &q1, &p1, &lambda);
     ++steps_;
-    if (s.ok() && !(q1.allFinite() && p1.allFinite())) {
+    if (s.ok() && !(all_finite(q1) && all_finite(p1))) {
       s.status = SolveStatus::kFailed;
       s.failure = FailureKind::kNonFinite;
       s.message = "non-finite state";

@@ -133,17 +133,20 @@ inline Vec<T, S::n> discrete_lagrangian_slot(const S& sys, const D& disc, double
 
 // omega_d(q0, q1) (eq. 13 / 14); *scale (optional) gets sum_i w_i |omega(q_c)| |q1-q0|/h,
 // the size of the terms, against which round-off in omega_d is judged.
-template <class S, class D, class T>
-inline Vec<T, S::m> discrete_constraint(const S& sys, const D& disc, double h,
-                                        const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
-                                        Vec<double, S::m>* scale = nullptr) {
+// omega_at(k, q_c) gives omega(q_c) at the k-th constraint node (a caller
+// may have it at hand: DlaStepper's passes, issue 13).
+template <class S, class D, class T, class OmegaAt>
+inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& disc, double h,
+                                             const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
+                                             Vec<double, S::m>* scale = nullptr) {
   Vec<T, S::n> v;
   for (int i = 0; i < S::n; ++i) v[i] = divide(T(q1[i] - q0[i]), h);
   Vec<T, S::m> w;
   w.setConstant(cst<T>(0.0));
   if (scale) scale->setZero();
+  int k = 0;
   for (const Node& nd : disc.constraint_nodes()) {
-    const Mat<T, S::m, S::n> W = sys.template omega<T>(interpolate(q0, q1, nd.c));
+    const Mat<T, S::m, S::n> W = omega_at(k++, interpolate(q0, q1, nd.c));
     w += cst<T>(nd.weight) * (W * v);
     if (scale) {
       for (int a = 0; a < S::m; ++a)
@@ -152,6 +155,14 @@ inline Vec<T, S::m> discrete_constraint(const S& sys, const D& disc, double h,
     }
   }
   return w;
+}
+
+template <class S, class D, class T>
+inline Vec<T, S::m> discrete_constraint(const S& sys, const D& disc, double h,
+                                        const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
+                                        Vec<double, S::m>* scale = nullptr) {
+  return discrete_constraint_with<S, D, T>([&](int, const Vec<T, S::n>& q) { return sys.template omega<T>(q); },
+                                           disc, h, q0, q1, scale);
 }
 
 }  // namespace nhi

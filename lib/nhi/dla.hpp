@@ -25,7 +25,11 @@
 // So the map on T*Q is not self-adjoint; MethodTraits says symmetric_in_phase = false.
 #pragma once
 
+#include <array>
 #include <limits>
+#include <tuple>
+#include <type_traits>
+#include <utility>
 #include <optional>
 #include <string>
 
@@ -37,6 +41,36 @@
 namespace nhi {
 
 using DlaOptions = SolverOptions;
+
+// omega at the constraint nodes of the last evaluations, keyed by the
+// coordinates omega reads (DlaStepper::omega_reads): a node whose read
+// coordinates are the same bits gets the same omega without evaluating it.
+// On the robot theta is exact after the predictor's first pass, so its
+// sincos is taken once or twice a step instead of at every pass and
+// residual (issue 13).
+template <class S, int kNodes>
+struct OmegaMemo {
+  static constexpr int n = S::n, m = S::m;
+  std::array<bool, n> reads{};
+  std::array<Vec<double, n>, kNodes> q;
+  std::array<Mat<double, m, n>, kNodes> W;
+  std::array<bool, kNodes> valid{};
+  OmegaMemo() {  // (zero, so that a memo copies cleanly before its first use)
+    for (auto& x : q) x.setZero();
+    for (auto& w : W) w.setZero();
+  }
+  const Mat<double, m, n>& at(const S& sys, int k, const Vec<double, n>& qc) {
+    bool same = valid[k];
+    for (int j = 0; j < n && same; ++j)
+      if (reads[j] && !(qc[j] == q[k][j])) same = false;
+    if (!same) {
+      q[k] = qc;
+      W[k] = sys.template omega<double>(qc);
+      valid[k] = true;
+    }
+    return W[k];
+  }
+};
 
 // The residual of eq. (6) / (17) at fixed (q_k, p_k), for NewtonSolver.
 template <class S, class D>
@@ -57,6 +91,9 @@ struct DlaStepProblem {
 
   DlaStepProblem(const S& s, const D& d, double hh, const VecN& q, const VecN& p)
       : sys(s), disc(d), h(hh), q_curr(q), p_curr(p), W_t(force_forms(s, q).transpose()) {}
+  // With force_forms(q)^T already at hand (the stepper's predictor computed it).
+  DlaStepProblem(const S& s, const D& d, double hh, const VecN& q, const VecN& p, const Mat<double, n, mc>& Wt)
+      : sys(s), disc(d), h(hh), q_curr(q), p_curr(p), W_t(Wt) {}
 
   // The one-forms the multipliers act on at q_k: omega(q_k) and, with holonomic
   // constraints, Dg(q_k) below it (eq. 17, first line).
@@ -68,6 +105,9 @@ struct DlaStepProblem {
   }
 
   const Mat<double, n, mc>& Wt() const { return W_t; }
+
+  using Memo = OmegaMemo<S, std::tuple_size<decltype(std::declval<const D&>().constraint_nodes())>::value>;
+  Memo* memo = nullptr;  // omega at the constraint nodes, for the double residual (may be null)
 
   // Round-off in (q1 - q0)/h grows with |q_k| + |q_{k+1}| (a coordinate that has travelled far).
   VecN y_scale(const VecN& q1) const { return q_curr.cwiseAbs() + q1.cwiseAbs(); }
@@ -81,7 +121,16 @@ struct DlaStepProblem {
     Vec<T, n> D1;
     discrete_lagrangian_slots<S, D, T>(sys, disc, h, q0, q1, &D1, nullptr);  // eq. 9 / 10
     Vec<double, m> cscale;
-    const Vec<T, m> wd = discrete_constraint<S, D, T>(sys, disc, h, q0, q1, terms ? &cscale : nullptr);  // eq. 13 / 14
+    Vec<T, m> wd;  // eq. 13 / 14
+    if constexpr (std::is_same_v<T, double>) {
+      if (memo)
+        wd = discrete_constraint_with<S, D, T>([this](int k, const VecN& qc) { return memo->at(sys, k, qc); }, disc,
+                                               h, q0, q1, terms ? &cscale : nullptr);
+      else
+        wd = discrete_constraint<S, D, T>(sys, disc, h, q0, q1, terms ? &cscale : nullptr);
+    } else {
+      wd = discrete_constraint<S, D, T>(sys, disc, h, q0, q1, terms ? &cscale : nullptr);
+    }
     for (int i = 0; i < n; ++i) {
       T force = cst<T>(0.0);
       for (int a = 0; a < mc; ++a) force += scale(lambda[a], W_t(i, a));
@@ -129,16 +178,20 @@ class DlaMap {
   // starting iterate; on success q_next, lambda and p_next hold the solution.
   // check_guess: the guess may already solve the step, and polish corrects
   // it if it does (NewtonSolver::solve).
+  // Wt (may be null): force_forms(q_curr)^T, if the caller has it; memo (may
+  // be null): omega at the constraint nodes of earlier evaluations.
   template <class Polish = typename NewtonSolver<Problem>::NoPolish>
   StepSummary step(const VecN& q_curr, const VecN& p_curr, const VecN& q_guess, VecN* q_next,
-                   VecM* lambda, VecN* p_next, bool check_guess = false, const Polish& polish = {}) const {
-    const Problem prob(sys_, disc_, h_, q_curr, p_curr);
+                   VecM* lambda, VecN* p_next, bool check_guess = false, const Polish& polish = {},
+                   const Mat<double, n, mc>* Wt = nullptr, typename Problem::Memo* memo = nullptr) const {
+    Problem prob = Wt ? Problem(sys_, disc_, h_, q_curr, p_curr, *Wt) : Problem(sys_, disc_, h_, q_curr, p_curr);
+    prob.memo = memo;
     VecN q1 = q_guess;
     StepSummary s = NewtonSolver<Problem>(prob, options_).solve(&q1, lambda, check_guess, polish);
     if (s.status == SolveStatus::kConverged) {
       *q_next = q1;
       discrete_lagrangian_slots<S, D, double>(sys_, disc_, h_, q_curr, *q_next, nullptr, p_next);
-      if (!p_next->allFinite()) {
+      if (!all_finite(*p_next)) {
         s.status = SolveStatus::kFailed;
         s.failure = FailureKind::kNonFinite;
         s.message = "non-finite momentum p_{k+1}";
@@ -191,7 +244,9 @@ class DlaStepper {
   using VecN = Vec<double, n>;
   using VecM = typename Map::VecM;
 
-  DlaStepper(const S& sys, const D& disc, DlaOptions options = {}) : map_(sys, disc, 0.0, options) {
+  DlaStepper(const S& sys, const D& disc, DlaOptions options = {})
+      : map_(sys, disc, 0.0, options) {
+    omega_memo_.reads = omega_reads(sys);
     if constexpr (kPassesSolveMultipliers) {
       // M^-1 (constant on a separable system) and kappa = sum_c w_c c (1 - c)
       // for the curvature of the passes (next_guess).
@@ -263,10 +318,10 @@ class DlaStepper {
     // (Only a guess the passes refined is worth the check: the stages of a
     // composition that turn back get the plain extrapolation.)
     const bool check = settled || (accepted_last && predicted);
-    StepSummary st = map_.step(q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_, check,
-                               [this, h](const Vec<double, n + Map::mc>& r, VecN* q1, VecM* lambda) {
-                                 polish(h, r, q1, lambda);
-                               });
+    StepSummary st = map_.step(
+        q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_, check,
+        [this, h](const Vec<double, n + Map::mc>& r, VecN* q1, VecM* lambda) { polish(h, r, q1, lambda); },
+        predicted ? &guess_Wt_ : nullptr, &omega_memo_);
     accepted_ = st.ok() && st.jacobians == 0;  // the residual check took the guess
     if (!st.ok() && predicted) {
       // A large step can start outside Newton's basin from the predictor
@@ -282,7 +337,7 @@ class DlaStepper {
       st = retry;
     }
     ++steps_;
-    if (st.status != SolveStatus::kConverged || !q_next_.allFinite()) {
+    if (st.status != SolveStatus::kConverged || !all_finite(q_next_)) {
       if (st.status == SolveStatus::kConverged) st.failure = FailureKind::kNonFinite;
       st.status = SolveStatus::kFailed;
       st.message = "step solve for q_" + std::to_string(steps_) + " did not converge: " +
@@ -353,7 +408,8 @@ class DlaStepper {
     const S& sys = map_.system();
     const D& disc = map_.discretization();
     const VecN& q = q_next_;
-    const Mat<double, n, Map::mc> Wt = Map::Problem::force_forms(sys, q).transpose();
+    guess_Wt_ = Map::Problem::force_forms(sys, q).transpose();
+    const Mat<double, n, Map::mc>& Wt = guess_Wt_;
     double cbar = 0;
     for (const Node& nd : disc.nodes()) cbar += nd.weight * nd.c;
     // Without the multiplier solve the passes converge to a fixed point with
@@ -382,7 +438,7 @@ class DlaStepper {
         const double det = G.determinant();
         if (MhkK.cwiseAbs().maxCoeff() >= 1e-6 && std::isfinite(det) && std::abs(det) > 0.5) {  // h^2 kappa K small against M
           P_ = G.inverse() * Minv_;
-          P_ok_ = P_.allFinite();
+          P_ok_ = all_finite(P_);
         }
       }
     }
@@ -392,6 +448,7 @@ class DlaStepper {
       polish_curved_ = curved;
       polish_Wt_ = Wt;
     }
+    Mat<double, n, Map::mc> VWt;  // V(q, W^T e_a) (separable: independent of q)
     for (int pass = 0; pass < passes; ++pass) {
       const VecN vg = (*q_guess - q) * inv_h;
       VecN rhs = p_next_;
@@ -405,8 +462,9 @@ class DlaStepper {
       VecN q1;
       if constexpr (kPassesSolveMultipliers) {
         Mat<double, m, n> Om = Mat<double, m, n>::Zero();
-        for (const Node& nd : disc.constraint_nodes())
-          Om += nd.weight * sys.template omega<double>(VecN((1.0 - nd.c) * q + nd.c * *q_guess));
+        int node = 0;
+        for (const Node& nd : disc.constraint_nodes())  // (OmegaMemo: the robot's theta is exact after one pass)
+          Om += nd.weight * omega_memo_.at(sys, node++, VecN((1.0 - nd.c) * q + nd.c * *q_guess));
         Mat<double, m, m> Sinv;
         if (curved) {
           const VecN Prhs = P_ * VecN(rhs - hkK_ * vg);
@@ -414,8 +472,9 @@ class DlaStepper {
           lambda = Sinv * VecM(Om * Prhs);
           q1 = q + h * VecN(Prhs - PWt * lambda);
         } else {
-          Mat<double, m, m> A;
-          for (int a = 0; a < m; ++a) A.col(a) = Om * velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
+          if (pass == 0)  // V(q, .) does not depend on q here: the same for every pass
+            for (int a = 0; a < m; ++a) VWt.col(a) = velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
+          const Mat<double, m, m> A = Om * VWt;
           Sinv = A.inverse();
           lambda = Sinv * VecM(Om * velocity<S, double>(sys, qbar, rhs));
           q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
@@ -426,7 +485,7 @@ class DlaStepper {
       } else {
         q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
       }
-      if (!(q1.allFinite() && lambda.allFinite())) return;
+      if (!(all_finite(q1) && all_finite(lambda))) return;
       const bool fixed = ((q1 - *q_guess).cwiseAbs() - kSettled * (q.cwiseAbs() + q1.cwiseAbs())).maxCoeff() <= 0;
       *q_guess = q1;
       *lambda_guess = lambda;
@@ -464,11 +523,29 @@ class DlaStepper {
       const VecM dl = polish_Sinv_ * VecM(polish_Om_ * Grf + r.template tail<Map::mc>());
       const VecN q = *q1 + h * VecN(G * VecN(r.template head<n>() - polish_Wt_ * dl));
       const VecM l = *lambda + dl;
-      if (q.allFinite() && l.allFinite()) {
+      if (all_finite(q) && all_finite(l)) {
         *q1 = q;
         *lambda = l;
       }
     }
+  }
+
+  // Which coordinates does omega read?  Those with a non-zero derivative of
+  // some row at one of two unrelated states (autodiff; a structural zero is
+  // exactly zero).
+  static std::array<bool, n> omega_reads(const S& sys) {
+    std::array<bool, n> reads{};
+    using J = ceres::Jet<double, n>;
+    for (int probe = 0; probe < 2; ++probe) {
+      Vec<J, n> qj;
+      for (int i = 0; i < n; ++i) qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
+      const Mat<J, m, n> W = sys.template omega<J>(qj);
+      for (int a = 0; a < m; ++a)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i)
+            if (!(W(a, j).v[i] == 0.0)) reads[i] = true;
+    }
+    return reads;
   }
 
   // The linear extrapolation q_{k+1} + (h / h_k)(q_{k+1} - q_k) (steps >= 1).
@@ -508,6 +585,8 @@ class DlaStepper {
   double kappa_ = 0;
   bool affine_potential_force_ = false;  // dL/dq affine in q (K constant, maybe 0)
   std::optional<Mat<double, n, n>> K_;   // K when constant and not 0
+  mutable typename Map::Problem::Memo omega_memo_;  // omega at the constraint nodes (OmegaMemo)
+  mutable Mat<double, n, Map::mc> guess_Wt_ = Mat<double, n, Map::mc>::Zero();  // force_forms(q_{k+1})^T, by next_guess
   mutable Mat<double, n, n> P_ = Mat<double, n, n>::Zero(), hkK_ = Mat<double, n, n>::Zero();
   mutable double P_h_ = 0;
   mutable bool P_ok_ = false;

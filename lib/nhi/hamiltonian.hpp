@@ -111,7 +111,7 @@ inline std::optional<Mat<double, S::n, S::n>> constant_force_jacobian(const S& s
     lagrangian_partials(sys, qj, vj, &Lq, &Lv);
     for (int i = 0; i < n; ++i) K[probe].row(i) = Lq[i].v.transpose();
   }
-  if (K[0].allFinite() && K[0] == K[1]) return K[0];
+  if (all_finite(K[0]) && K[0] == K[1]) return K[0];
   return std::nullopt;
 }
 

@@ -304,7 +304,7 @@ class Mp06Stepper {
     VecM lambda = lambda_;
     StepSummary s = map(h, q_, p_, &q1, &p1, &lambda);
     ++steps_;
-    if (s.ok() && !(q1.allFinite() && p1.allFinite())) {
+    if (s.ok() && !(all_finite(q1) && all_finite(p1))) {
       s.status = SolveStatus::kFailed;
       s.failure = FailureKind::kNonFinite;
       s.message = "non-finite state";

@@ -170,7 +170,7 @@ class ReducedDla {
         for (int j = 0; j < k; ++j) Jm(i, j) = g[i].v[j];
       }
       const VecR dx = Jm.partialPivLu().solve(val);
-      if (!dx.allFinite()) break;
+      if (!all_finite(dx)) break;
       x -= dx;
       if (dx.cwiseAbs().maxCoeff() <= 4e-16 * (1.0 + x.cwiseAbs().maxCoeff())) {
         res.converged = true;

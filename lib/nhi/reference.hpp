@@ -106,7 +106,7 @@ class CvodeReference {
       yd[i] = v[i];
       yd[n + i] = a[i];
     }
-    return a.allFinite() ? 0 : 1;  // recoverable: CVODE retries with a smaller step
+    return all_finite(a) ? 0 : 1;  // recoverable: CVODE retries with a smaller step
   }
   static void on_error(int code, const char* module, const char* function, char* msg,
                        void* user) {
@@ -167,7 +167,7 @@ class ReferenceStepper {
     if (!ok) {
       s.failure = FailureKind::kSolve;
       s.message = "CVODE failed: " + cv_->message();
-    } else if (!q_.allFinite() || !v_.allFinite()) {
+    } else if (!all_finite(q_) || !all_finite(v_)) {
       s.failure = FailureKind::kNonFinite;
       s.message = "state became non-finite at step " + std::to_string(k_);
     } else {

@@ -40,7 +40,7 @@ class Rk4Stepper {
     ++steps_;
     StepSummary s;
     s.rhs_evaluations = rhs_per_step();
-    if (q_.allFinite() && v_.allFinite()) {
+    if (all_finite(q_) && all_finite(v_)) {
       s.status = SolveStatus::kConverged;
     } else {
       s.failure = FailureKind::kNonFinite;

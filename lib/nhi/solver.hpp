@@ -250,7 +250,7 @@ class NewtonSolver {
           const double detS = Sm.determinant();
           if (std::isfinite(detS) && std::abs(detS) > 1e-10 * power<nl>(Sm.cwiseAbs().maxCoeff())) {
             Sinv_ = Sm.inverse();
-            schur_ok_ = Sinv_.allFinite();
+            schur_ok_ = all_finite(Sinv_);
           }
         }
       }
@@ -321,7 +321,7 @@ class NewtonSolver {
       }
       if (fresh) solver.factor(Jy);
       const VecX dx = solver.solve(r);
-      if (!dx.allFinite()) {
+      if (!all_finite(dx)) {
         s.message = "singular step matrix (eq. 7)";
         s.failure = FailureKind::kSolve;
         return s;
