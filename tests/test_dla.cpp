@@ -194,7 +194,7 @@ void expect_fast_path_exact(const D& disc, double h, long steps) {
 
 // The stepper does not evaluate omega again at a constraint node whose
 // coordinates omega reads are the same bits (OmegaMemo, issue 13).  That is
-// right only if omega_reads() finds every coordinate omega depends on: here a
+// right only if omega_reads() (dla.hpp) finds every coordinate omega depends on: here a
 // coordinate it leaves out never changes omega, one it lists does, and the
 // memo gives omega(q) bit for bit along a sequence of states in which the
 // unread coordinates move alone.
@@ -206,8 +206,7 @@ TYPED_TEST(DlaTest, OmegaMemoIsOmegaBitForBit) {
   for (int trial = 0; trial < 4; ++trial) {
     const S sys = trial == 0 ? make_system<S>() : randomized_system<S>(rng);
     using Stepper = DlaStepper<S, AlphaDiscretization>;
-    typename Stepper::Map::Problem::Memo memo;
-    memo.reads = Stepper::omega_reads(sys);
+    typename Stepper::Map::Problem::Memo memo(sys);
     for (int k = 0; k < 50; ++k) {
       Vec<double, n> q, v;
       random_state<S>(rng, &q, &v, sys);

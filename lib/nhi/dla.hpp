@@ -42,8 +42,28 @@ namespace nhi {
 
 using DlaOptions = SolverOptions;
 
+// Which coordinates does omega read?  Those with a non-zero derivative of
+// some row at one of two unrelated states (autodiff; a structural zero is
+// exactly zero).
+template <class S>
+std::array<bool, S::n> omega_reads(const S& sys) {
+  constexpr int n = S::n, m = S::m;
+  std::array<bool, n> reads{};
+  using J = ceres::Jet<double, n>;
+  for (int probe = 0; probe < 2; ++probe) {
+    Vec<J, n> qj;
+    for (int i = 0; i < n; ++i) qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
+    const Mat<J, m, n> W = sys.template omega<J>(qj);
+    for (int a = 0; a < m; ++a)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+          if (!(W(a, j).v[i] == 0.0)) reads[i] = true;
+  }
+  return reads;
+}
+
 // omega at the constraint nodes of the last evaluations, keyed by the
-// coordinates omega reads (DlaStepper::omega_reads): a node whose read
+// coordinates omega reads (omega_reads above): a node whose read
 // coordinates are the same bits gets the same omega without evaluating it.
 // On the robot theta is exact after the predictor's first pass, so its
 // sincos is taken once or twice a step instead of at every pass and
@@ -51,11 +71,11 @@ using DlaOptions = SolverOptions;
 template <class S, int kNodes>
 struct OmegaMemo {
   static constexpr int n = S::n, m = S::m;
-  std::array<bool, n> reads{};
+  std::array<bool, n> reads;
   std::array<Vec<double, n>, kNodes> q;
   std::array<Mat<double, m, n>, kNodes> W;
   std::array<bool, kNodes> valid{};
-  OmegaMemo() {  // (zero, so that a memo copies cleanly before its first use)
+  explicit OmegaMemo(const S& sys) : reads(omega_reads(sys)) {  // (q, W zero: a memo copies cleanly before its first use)
     for (auto& x : q) x.setZero();
     for (auto& w : W) w.setZero();
   }
@@ -89,11 +109,10 @@ struct DlaStepProblem {
   const VecN& p_curr;
   Mat<double, n, mc> W_t;  // force_forms(q_k)^T: the multiplier columns
 
-  DlaStepProblem(const S& s, const D& d, double hh, const VecN& q, const VecN& p)
-      : sys(s), disc(d), h(hh), q_curr(q), p_curr(p), W_t(force_forms(s, q).transpose()) {}
-  // With force_forms(q)^T already at hand (the stepper's predictor computed it).
-  DlaStepProblem(const S& s, const D& d, double hh, const VecN& q, const VecN& p, const Mat<double, n, mc>& Wt)
-      : sys(s), disc(d), h(hh), q_curr(q), p_curr(p), W_t(Wt) {}
+  // Wt (may be null): force_forms(q)^T, if the caller has it (the stepper's predictor).
+  DlaStepProblem(const S& s, const D& d, double hh, const VecN& q, const VecN& p,
+                 const Mat<double, n, mc>* Wt = nullptr)
+      : sys(s), disc(d), h(hh), q_curr(q), p_curr(p), W_t(Wt ? *Wt : force_forms(s, q).transpose()) {}
 
   // The one-forms the multipliers act on at q_k: omega(q_k) and, with holonomic
   // constraints, Dg(q_k) below it (eq. 17, first line).
@@ -121,16 +140,12 @@ struct DlaStepProblem {
     Vec<T, n> D1;
     discrete_lagrangian_slots<S, D, T>(sys, disc, h, q0, q1, &D1, nullptr);  // eq. 9 / 10
     Vec<double, m> cscale;
-    Vec<T, m> wd;  // eq. 13 / 14
-    if constexpr (std::is_same_v<T, double>) {
-      if (memo)
-        wd = discrete_constraint_with<S, D, T>([this](int k, const VecN& qc) { return memo->at(sys, k, qc); }, disc,
-                                               h, q0, q1, terms ? &cscale : nullptr);
-      else
-        wd = discrete_constraint<S, D, T>(sys, disc, h, q0, q1, terms ? &cscale : nullptr);
-    } else {
-      wd = discrete_constraint<S, D, T>(sys, disc, h, q0, q1, terms ? &cscale : nullptr);
-    }
+    const auto omega_at = [this](int k, const Vec<T, n>& qc) -> Mat<T, m, n> {
+      if constexpr (std::is_same_v<T, double>)
+        if (memo) return memo->at(sys, k, qc);
+      return sys.template omega<T>(qc);
+    };
+    const Vec<T, m> wd = discrete_constraint_with<S, D, T>(omega_at, disc, h, q0, q1, terms ? &cscale : nullptr);  // eq. 13 / 14
     for (int i = 0; i < n; ++i) {
       T force = cst<T>(0.0);
       for (int a = 0; a < mc; ++a) force += scale(lambda[a], W_t(i, a));
@@ -184,7 +199,7 @@ class DlaMap {
   StepSummary step(const VecN& q_curr, const VecN& p_curr, const VecN& q_guess, VecN* q_next,
                    VecM* lambda, VecN* p_next, bool check_guess = false, const Polish& polish = {},
                    const Mat<double, n, mc>* Wt = nullptr, typename Problem::Memo* memo = nullptr) const {
-    Problem prob = Wt ? Problem(sys_, disc_, h_, q_curr, p_curr, *Wt) : Problem(sys_, disc_, h_, q_curr, p_curr);
+    Problem prob(sys_, disc_, h_, q_curr, p_curr, Wt);
     prob.memo = memo;
     VecN q1 = q_guess;
     StepSummary s = NewtonSolver<Problem>(prob, options_).solve(&q1, lambda, check_guess, polish);
@@ -245,8 +260,7 @@ class DlaStepper {
   using VecM = typename Map::VecM;
 
   DlaStepper(const S& sys, const D& disc, DlaOptions options = {})
-      : map_(sys, disc, 0.0, options) {
-    omega_memo_.reads = omega_reads(sys);
+      : map_(sys, disc, 0.0, options), omega_memo_(sys) {
     if constexpr (kPassesSolveMultipliers) {
       // M^-1 (constant on a separable system) and kappa = sum_c w_c c (1 - c)
       // for the curvature of the passes (next_guess).
@@ -446,7 +460,6 @@ class DlaStepper {
     if (curved) PWt = P_ * Wt;
     if constexpr (kPassesSolveMultipliers) {
       polish_curved_ = curved;
-      polish_Wt_ = Wt;
     }
     Mat<double, n, Map::mc> VWt;  // V(q, W^T e_a) (separable: independent of q)
     for (int pass = 0; pass < passes; ++pass) {
@@ -521,31 +534,13 @@ class DlaStepper {
       const Mat<double, n, n>& G = polish_curved_ ? P_ : Minv_;
       const VecN Grf = G * VecN(r.template head<n>());
       const VecM dl = polish_Sinv_ * VecM(polish_Om_ * Grf + r.template tail<Map::mc>());
-      const VecN q = *q1 + h * VecN(G * VecN(r.template head<n>() - polish_Wt_ * dl));
+      const VecN q = *q1 + h * VecN(G * VecN(r.template head<n>() - guess_Wt_ * dl));
       const VecM l = *lambda + dl;
       if (all_finite(q) && all_finite(l)) {
         *q1 = q;
         *lambda = l;
       }
     }
-  }
-
-  // Which coordinates does omega read?  Those with a non-zero derivative of
-  // some row at one of two unrelated states (autodiff; a structural zero is
-  // exactly zero).
-  static std::array<bool, n> omega_reads(const S& sys) {
-    std::array<bool, n> reads{};
-    using J = ceres::Jet<double, n>;
-    for (int probe = 0; probe < 2; ++probe) {
-      Vec<J, n> qj;
-      for (int i = 0; i < n; ++i) qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
-      const Mat<J, m, n> W = sys.template omega<J>(qj);
-      for (int a = 0; a < m; ++a)
-        for (int j = 0; j < n; ++j)
-          for (int i = 0; i < n; ++i)
-            if (!(W(a, j).v[i] == 0.0)) reads[i] = true;
-    }
-    return reads;
   }
 
   // The linear extrapolation q_{k+1} + (h / h_k)(q_{k+1} - q_k) (steps >= 1).
@@ -586,7 +581,7 @@ class DlaStepper {
   bool affine_potential_force_ = false;  // dL/dq affine in q (K constant, maybe 0)
   std::optional<Mat<double, n, n>> K_;   // K when constant and not 0
   mutable typename Map::Problem::Memo omega_memo_;  // omega at the constraint nodes (OmegaMemo)
-  mutable Mat<double, n, Map::mc> guess_Wt_ = Mat<double, n, Map::mc>::Zero();  // force_forms(q_{k+1})^T, by next_guess
+  mutable Mat<double, n, Map::mc> guess_Wt_ = Mat<double, n, Map::mc>::Zero();  // force_forms(q_{k+1})^T, by next_guess (for the solve and polish())
   mutable Mat<double, n, n> P_ = Mat<double, n, n>::Zero(), hkK_ = Mat<double, n, n>::Zero();
   mutable double P_h_ = 0;
   mutable bool P_ok_ = false;
@@ -597,10 +592,9 @@ class DlaStepper {
   long steps_ = 0;
   double h_ = 0, h_prev_ = 0;
   bool accepted_ = false;  // did the residual check accept the last step's guess?
-  // The last pass's matrices for polish(): Omega, (Omega G W^T)^-1, W^T, and G = P or M^-1.
+  // The last pass's matrices for polish(): Omega, (Omega G W^T)^-1, and G = P or M^-1 (W^T: guess_Wt_).
   mutable Mat<double, Map::mc, n> polish_Om_ = Mat<double, Map::mc, n>::Zero();
   mutable Mat<double, Map::mc, Map::mc> polish_Sinv_ = Mat<double, Map::mc, Map::mc>::Zero();
-  mutable Mat<double, n, Map::mc> polish_Wt_ = Mat<double, n, Map::mc>::Zero();
   mutable bool polish_curved_ = false, polish_ok_ = false;
 };
 
