@@ -52,7 +52,7 @@ std::array<bool, S::n> omega_reads(const S& sys) {
   using J = ceres::Jet<double, n>;
   for (int probe = 0; probe < 2; ++probe) {
     Vec<J, n> qj;
-    for (int i = 0; i < n; ++i) qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
+    for (int i = 0; i < n; ++i) qj[i] = J(probe_q(i, probe), i);
     const Mat<J, m, n> W = sys.template omega<J>(qj);
     for (int a = 0; a < m; ++a)
       for (int j = 0; j < n; ++j)
@@ -91,6 +91,26 @@ struct OmegaMemo {
     return W[k];
   }
 };
+
+// dL/dq at (q, v) and its derivative in coordinate r, by one Jet evaluation
+// of the partials with one derivative (DlaStepper::next_guess).
+template <class S>
+void partials_and_curvature(const S& sys, const Vec<double, S::n>& q, const Vec<double, S::n>& v, int r,
+                            Vec<double, S::n>* Lq, Vec<double, S::n>* dLq) {
+  constexpr int n = S::n;
+  using J = ceres::Jet<double, 1>;
+  Vec<J, n> qj, vj, Lqj, Lvj;
+  for (int i = 0; i < n; ++i) {
+    qj[i] = J(q[i]);
+    vj[i] = J(v[i]);
+  }
+  qj[r].v[0] = 1.0;
+  lagrangian_partials(sys, qj, vj, &Lqj, &Lvj);
+  for (int i = 0; i < n; ++i) {
+    (*Lq)[i] = Lqj[i].a;
+    (*dLq)[i] = Lqj[i].v[0];
+  }
+}
 
 // The residual of eq. (6) / (17) at fixed (q_k, p_k), for NewtonSolver.
 template <class S, class D>
@@ -251,6 +271,11 @@ class DlaStepper {
   // 8th step to find out, and is checked only if a pass moved nothing
   // (issue 13; measured in the README).
   static constexpr int kMaxPasses = 4, kMinPasses = 2;
+  // Passes that take the curvature of a potential of one coordinate (next_guess)
+  // converge quadratically: from the extrapolation the third is at round-off
+  // and the residual check confirms it (a fourth pass would cost more).
+  static constexpr int kNewtonPasses = 3, kMaxNewtonPasses = 5;
+  static constexpr double kSqrtEps = 1.4901161193847656e-08;  // 2^-26
   static constexpr double kSettled = 4 * std::numeric_limits<double>::epsilon();
   using Map = DlaMap<S, D>;
   // Do the passes solve for the multipliers too (next_guess)?  Needs V linear
@@ -272,6 +297,17 @@ class DlaStepper {
         if (const auto K = constant_force_jacobian(map_.system())) {
           affine_potential_force_ = true;
           if ((K->array() != 0.0).any()) K_ = *K;
+        } else {
+          // A potential of one coordinate r (the robot's V0 sin psi): the
+          // passes take its curvature at every pass (next_guess).
+          const std::array<bool, n> reads = force_reads(map_.system());
+          int count = 0;
+          for (int j = 0; j < n; ++j)
+            if (reads[j]) {
+              ++count;
+              curvature_coordinate_ = j;
+            }
+          if (count != 1) curvature_coordinate_ = -1;
         }
       }
     }
@@ -285,6 +321,9 @@ class DlaStepper {
   // Then, where the constraint rows read only coordinates the constraint
   // force does not move, they settle (tests/test_dla.cpp).
   bool passes_exact_in_potential() const { return kPassesSolveMultipliers && (kappa_ == 0 || affine_potential_force_); }
+  // Do the passes take the curvature of a potential of one coordinate at
+  // every pass (next_guess), so that they converge quadratically?
+  bool passes_newton_in_potential() const { return curvature_coordinate_ >= 0; }
 
   MethodTraits traits() const {
     MethodTraits t;
@@ -315,7 +354,9 @@ class DlaStepper {
     VecM lambda_guess;
     bool settled = false;
     const bool accepted_last = accepted_;
-    next_guess(h, &guess, &lambda_guess, accepted_last || steps_ % 8 != 0 ? kMinPasses : kMaxPasses, &settled);
+    next_guess(h, &guess, &lambda_guess,
+               curvature_coordinate_ >= 0 ? kNewtonPasses : accepted_last || steps_ % 8 != 0 ? kMinPasses : kMaxPasses,
+               &settled, true);
     const bool predicted = one_direction(h);  // next_guess extrapolated lambda and refined q
     if (predicted) plain = extrapolation(h);
     const VecM lambda_plain = lambda_;
@@ -405,7 +446,25 @@ class DlaStepper {
   // the contact oscillator, did not settle in kMinPasses, and made the steps
   // slower (robot 610 -> 720 ns, chaotic oscillator 850 -> 1430 ns): those
   // systems keep the passes above, as do kappa = 0 and K = 0.
-  void next_guess(double h, VecN* q_guess, VecM* lambda_guess, int passes, bool* settled = nullptr) const {
+  //   Except a potential of one coordinate r (dL/dq reads q_r alone, found by
+  // autodiff at construction: the robot's V0 sin psi).  Then K = d(dL/dq)/dq
+  // has one column, and every pass takes it at the nodes by a Jet of one
+  // derivative, linearizes dL/dq in q_next there, and solves with
+  // (M - u e_r^T)^-1 by Sherman-Morrison (u = h^2 sum_c w_c c (1 - c) K e_r):
+  // a Newton step in the potential, so the passes converge quadratically, the
+  // third is at round-off and the residual check confirms it (kNewtonPasses).
+  // Measured in one run at h = 0.2 on the robot (ns per step, before -> after):
+  // midpoint rule 525-552 -> 414-415 (Newton iterations 1.79 -> 0.007),
+  // alpha = 1/4 521-580 -> 423-425, symmetric alpha = 1/4 721-742 -> 553-559.
+  // (The same with the curvature of every coordinate, a Jet of n derivatives
+  // and an n x n inverse per pass, removed the iterations too but made the
+  // robot's step slower, 701 -> 821 ns, and the contact oscillator's 313 -> 580.)
+  // extend: Newton passes (a potential of one coordinate) may add passes, up
+  // to kMaxNewtonPasses, while the last one moved by more than sqrt(eps) of
+  // the state's size (the stepper's own calls; at h = 0.4 three were often
+  // not enough).
+  void next_guess(double h, VecN* q_guess, VecM* lambda_guess, int passes, bool* settled = nullptr,
+                  bool extend = false) const {
     if (settled) *settled = false;
     polish_ok_ = false;
     if (steps_ == 0) {
@@ -461,13 +520,29 @@ class DlaStepper {
     if constexpr (kPassesSolveMultipliers) {
       polish_curved_ = curved;
     }
+    Mat<double, n, Map::mc> MWt;  // M^-1 W^T, for the passes with the curvature of one coordinate
+    bool rank_one_started = false;
     Mat<double, n, Map::mc> VWt;  // V(q, W^T e_a) (separable: independent of q)
+    // A potential of one coordinate r (see above): the curvature
+    // u = h^2 sum_c w_c c (1 - c) d(dL/dq)/dq_r at the nodes, by a Jet of one
+    // derivative at every pass.
+    const int r = curvature_coordinate_;
     for (int pass = 0; pass < passes; ++pass) {
       const VecN vg = (*q_guess - q) * inv_h;
       VecN rhs = p_next_;
+      VecN u = VecN::Zero();
+      bool newton_pass = false;
       for (const Node& nd : disc.nodes()) {
         VecN Lq, Lv;
-        lagrangian_partials(sys, VecN((1.0 - nd.c) * q + nd.c * *q_guess), vg, &Lq, &Lv);
+        const VecN qc = (1.0 - nd.c) * q + nd.c * *q_guess;
+        const double wcc = nd.weight * nd.c * (1.0 - nd.c);
+        if (r >= 0 && wcc != 0) {
+          VecN dLq;
+          partials_and_curvature(sys, qc, vg, r, &Lq, &dLq);
+          u += (h * h * wcc) * dLq;
+        } else {
+          lagrangian_partials(sys, qc, vg, &Lq, &Lv);
+        }
         rhs += (h * nd.weight * (1.0 - nd.c)) * Lq;
       }
       const VecN qbar = (1.0 - cbar) * q + cbar * *q_guess;
@@ -479,7 +554,32 @@ class DlaStepper {
         for (const Node& nd : disc.constraint_nodes())  // (OmegaMemo: the robot's theta is exact after one pass)
           Om += nd.weight * omega_memo_.at(sys, node++, VecN((1.0 - nd.c) * q + nd.c * *q_guess));
         Mat<double, m, m> Sinv;
-        if (curved) {
+        // The curvature of a potential of one coordinate r: the first line of
+        // eq. (6), linearized in q_next at the guess, is
+        //     (M - u e_r^T) v = rhs - u vg_r - W^T lambda,
+        // and (M - u e_r^T)^-1 = (I + z e_r^T / (1 - z_r)) M^-1, z = M^-1 u
+        // (Sherman-Morrison), so a pass is a Newton step in the potential (with
+        // the constraint nodes frozen).  Only while h^2 curvature is small against M
+        // (|1 - z_r| > 1/2, as for P), else the plain pass below.
+        VecN z;
+        double zs = 0;
+        if (r >= 0) {
+          z = Minv_ * u;
+          if (std::abs(1.0 - z[r]) > 0.5) zs = 1.0 / (1.0 - z[r]);
+        }
+        if (zs != 0) {
+          if (!rank_one_started) {  // (W^T is the step's: once)
+            MWt = Minv_ * Wt;
+            rank_one_started = true;
+          }
+          const Mat<double, n, m> GWt = MWt + (zs * z) * MWt.row(r);
+          const VecN y = Minv_ * VecN(rhs - vg[r] * u);
+          const VecN Grhs = y + (zs * y[r]) * z;
+          Sinv = Mat<double, m, m>(Om * GWt).inverse();
+          lambda = Sinv * VecM(Om * Grhs);
+          q1 = q + h * VecN(Grhs - GWt * lambda);
+          newton_pass = true;
+        } else if (curved) {
           const VecN Prhs = P_ * VecN(rhs - hkK_ * vg);
           Sinv = Mat<double, m, m>(Om * PWt).inverse();
           lambda = Sinv * VecM(Om * Prhs);
@@ -494,18 +594,27 @@ class DlaStepper {
         }
         polish_Om_ = Om;  // for polish(), from the last pass
         polish_Sinv_ = Sinv;
+        polish_zr_ = -1;
+        if (zs != 0) {
+          polish_z_ = zs * z;
+          polish_zr_ = r;
+        }
         polish_ok_ = true;
       } else {
         q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
       }
       if (!(all_finite(q1) && all_finite(lambda))) return;
       const bool fixed = ((q1 - *q_guess).cwiseAbs() - kSettled * (q.cwiseAbs() + q1.cwiseAbs())).maxCoeff() <= 0;
+      const VecN q_before = *q_guess;
       *q_guess = q1;
       *lambda_guess = lambda;
       if (fixed) {
         if (settled) *settled = true;
         return;
       }
+      if (extend && newton_pass && pass == passes - 1 && passes < kMaxNewtonPasses &&
+          (q1 - q_before).cwiseAbs().maxCoeff() > kSqrtEps * (1.0 + q.cwiseAbs().maxCoeff()))
+        ++passes;
     }
   }
 
@@ -531,10 +640,16 @@ class DlaStepper {
   void polish(double h, const Vec<double, n + Map::mc>& r, VecN* q1, VecM* lambda) const {
     if constexpr (kPassesSolveMultipliers) {  // (then there is no holonomic multiplier: mc = m)
       if (!polish_ok_) return;
-      const Mat<double, n, n>& G = polish_curved_ ? P_ : Minv_;
-      const VecN Grf = G * VecN(r.template head<n>());
+      // G x: P x, M^-1 x, or (I + z e_r^T / (1 - z_r)) M^-1 x (next_guess).
+      const auto G = [this](const VecN& x) -> VecN {
+        if (polish_curved_) return P_ * x;
+        const VecN y = Minv_ * x;
+        if (polish_zr_ < 0) return y;
+        return y + y[polish_zr_] * polish_z_;
+      };
+      const VecN Grf = G(VecN(r.template head<n>()));
       const VecM dl = polish_Sinv_ * VecM(polish_Om_ * Grf + r.template tail<Map::mc>());
-      const VecN q = *q1 + h * VecN(G * VecN(r.template head<n>() - guess_Wt_ * dl));
+      const VecN q = *q1 + h * G(VecN(r.template head<n>() - guess_Wt_ * dl));
       const VecM l = *lambda + dl;
       if (all_finite(q) && all_finite(l)) {
         *q1 = q;
@@ -596,6 +711,10 @@ class DlaStepper {
   mutable Mat<double, Map::mc, n> polish_Om_ = Mat<double, Map::mc, n>::Zero();
   mutable Mat<double, Map::mc, Map::mc> polish_Sinv_ = Mat<double, Map::mc, Map::mc>::Zero();
   mutable bool polish_curved_ = false, polish_ok_ = false;
+  mutable VecN polish_z_ = VecN::Zero();  // z / (1 - z_r) of the last pass, and r (-1: none)
+  mutable int polish_zr_ = -1;
+  // The one coordinate the potential reads when the passes take its curvature (-1: they do not).
+  int curvature_coordinate_ = -1;
 };
 
 }  // namespace nhi

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <Eigen/LU>
+#include <array>
 #include <optional>
 #include <type_traits>
 #include <utility>
@@ -91,6 +92,13 @@ inline Mat<double, S::n, S::n> inverse_mass_matrix(const S& sys) {
   return Minv;
 }
 
+// Coordinate i of two unrelated states (probe 0 and 1) at which the structural
+// probes look: constant_force_jacobian and force_reads below, omega_reads
+// (dla.hpp) and Mp06Stepper::explicit_structure (mp06.hpp).  A structural zero
+// of a derivative is exactly zero at both; a coincidental one is not.
+inline double probe_q(int i, int probe) { return 0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i; }
+inline double probe_v(int i, int probe) { return -0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i; }
+
 // K = d(dL/dq)/dq when it is the same bit for bit (by autodiff, one Jet
 // evaluation of the partials each) at two unrelated states: dL/dq affine in q,
 // a quadratic potential (K = 0: a linear one, or none).  nullopt otherwise.
@@ -105,14 +113,36 @@ inline std::optional<Mat<double, S::n, S::n>> constant_force_jacobian(const S& s
   for (int probe = 0; probe < 2; ++probe) {
     Vec<J, n> qj, vj, Lq, Lv;
     for (int i = 0; i < n; ++i) {
-      qj[i] = J(0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i, i);
-      vj[i] = J(-0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i);
+      qj[i] = J(probe_q(i, probe), i);
+      vj[i] = J(probe_v(i, probe));
     }
     lagrangian_partials(sys, qj, vj, &Lq, &Lv);
     for (int i = 0; i < n; ++i) K[probe].row(i) = Lq[i].v.transpose();
   }
   if (all_finite(K[0]) && K[0] == K[1]) return K[0];
   return std::nullopt;
+}
+
+// Which coordinates does dL/dq read?  Those with a non-zero derivative of some
+// component at one of the two probe states (autodiff; on a separable system
+// dL/dq = -grad U(q) does not depend on v).
+template <class S>
+inline std::array<bool, S::n> force_reads(const S& sys) {
+  constexpr int n = S::n;
+  using J = ceres::Jet<double, n>;
+  std::array<bool, n> reads{};
+  for (int probe = 0; probe < 2; ++probe) {
+    Vec<J, n> qj, vj, Lq, Lv;
+    for (int i = 0; i < n; ++i) {
+      qj[i] = J(probe_q(i, probe), i);
+      vj[i] = J(probe_v(i, probe));
+    }
+    lagrangian_partials(sys, qj, vj, &Lq, &Lv);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        if (!(Lq[i].v[j] == 0.0)) reads[j] = true;
+  }
+  return reads;
 }
 
 }  // namespace nhi

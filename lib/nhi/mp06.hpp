@@ -186,8 +186,8 @@ class Mp06Stepper {
       for (int probe = 0; probe < 2; ++probe) {
         VecN q0, p0;
         for (int i = 0; i < n; ++i) {
-          q0[i] = 0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i;
-          p0[i] = -0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i;
+          q0[i] = probe_q(i, probe);
+          p0[i] = probe_v(i, probe);
         }
         const Mp06SeparableProblem<S> prob(sys, 0.3, q0, p0);
         Vec<J, m> lj;
