@@ -541,6 +541,7 @@ class DlaStepper {
     Mat<double, n, Map::mc> MWt;  // M^-1 W^T, for the passes with the curvature of one coordinate
     bool rank_one_started = false;
     Mat<double, n, Map::mc> VWt;  // V(q, W^T e_a) (separable: independent of q)
+    bool vwt_ready = false;
     // A potential of one coordinate r (see above): the curvature
     // u = h^2 sum_c w_c c (1 - c) d(dL/dq)/dq_r at the nodes, by a Jet of one
     // derivative at every pass.
@@ -608,8 +609,10 @@ class DlaStepper {
           lambda = Sinv * VecM(Om * Prhs);
           q1 = q + h * VecN(Prhs - PWt * lambda);
         } else {
-          if (pass == 0)  // V(q, .) does not depend on q here: the same for every pass
+          if (!vwt_ready) {  // V(q, .) does not depend on q here: the same for every pass
             for (int a = 0; a < m; ++a) VWt.col(a) = velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
+            vwt_ready = true;  // (Newton passes can hand over to these after pass 0, at large h)
+          }
           const Mat<double, m, m> A = Om * VWt;
           Sinv = A.inverse();
           lambda = Sinv * VecM(Om * velocity<S, double>(sys, qbar, rhs));
