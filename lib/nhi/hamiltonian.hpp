@@ -99,48 +99,47 @@ inline Mat<double, S::n, S::n> inverse_mass_matrix(const S& sys) {
 inline double probe_q(int i, int probe) { return 0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i; }
 inline double probe_v(int i, int probe) { return -0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i; }
 
-// K = d(dL/dq)/dq when it is the same bit for bit (by autodiff, one Jet
-// evaluation of the partials each) at two unrelated states: dL/dq affine in q,
-// a quadratic potential (K = 0: a linear one, or none).  nullopt otherwise.
-// On a separable system dL/dq does not depend on v, so K is also dF/dq.  The
-// predictor passes of the DLA and the discrete gradient are exact in the
-// potential with it (dla.hpp, discrete_gradient.hpp).
+// d(dL/dq)/dq at probe state 0 or 1, by autodiff (one Jet evaluation of the
+// partials).  The two structural probes below read it.
 template <class S>
-inline std::optional<Mat<double, S::n, S::n>> constant_force_jacobian(const S& sys) {
+inline Mat<double, S::n, S::n> force_jacobian_at_probe(const S& sys, int probe) {
   constexpr int n = S::n;
   using J = ceres::Jet<double, n>;
-  Mat<double, n, n> K[2];
-  for (int probe = 0; probe < 2; ++probe) {
-    Vec<J, n> qj, vj, Lq, Lv;
-    for (int i = 0; i < n; ++i) {
-      qj[i] = J(probe_q(i, probe), i);
-      vj[i] = J(probe_v(i, probe));
-    }
-    lagrangian_partials(sys, qj, vj, &Lq, &Lv);
-    for (int i = 0; i < n; ++i) K[probe].row(i) = Lq[i].v.transpose();
+  Vec<J, n> qj, vj, Lq, Lv;
+  for (int i = 0; i < n; ++i) {
+    qj[i] = J(probe_q(i, probe), i);
+    vj[i] = J(probe_v(i, probe));
   }
-  if (all_finite(K[0]) && K[0] == K[1]) return K[0];
+  lagrangian_partials(sys, qj, vj, &Lq, &Lv);
+  Mat<double, n, n> K;
+  for (int i = 0; i < n; ++i) K.row(i) = Lq[i].v.transpose();
+  return K;
+}
+
+// K = d(dL/dq)/dq when it is the same bit for bit at the two unrelated probe
+// states: dL/dq affine in q, a quadratic potential (K = 0: a linear one, or
+// none).  nullopt otherwise.  On a separable system dL/dq does not depend on
+// v, so K is also dF/dq.  The predictor passes of the DLA and the discrete
+// gradient are exact in the potential with it (dla.hpp, discrete_gradient.hpp).
+template <class S>
+inline std::optional<Mat<double, S::n, S::n>> constant_force_jacobian(const S& sys) {
+  const auto K0 = force_jacobian_at_probe(sys, 0), K1 = force_jacobian_at_probe(sys, 1);
+  if (all_finite(K0) && K0 == K1) return K0;
   return std::nullopt;
 }
 
 // Which coordinates does dL/dq read?  Those with a non-zero derivative of some
-// component at one of the two probe states (autodiff; on a separable system
+// component at one of the two probe states (on a separable system
 // dL/dq = -grad U(q) does not depend on v).
 template <class S>
 inline std::array<bool, S::n> force_reads(const S& sys) {
   constexpr int n = S::n;
-  using J = ceres::Jet<double, n>;
   std::array<bool, n> reads{};
   for (int probe = 0; probe < 2; ++probe) {
-    Vec<J, n> qj, vj, Lq, Lv;
-    for (int i = 0; i < n; ++i) {
-      qj[i] = J(probe_q(i, probe), i);
-      vj[i] = J(probe_v(i, probe));
-    }
-    lagrangian_partials(sys, qj, vj, &Lq, &Lv);
+    const auto K = force_jacobian_at_probe(sys, probe);
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j)
-        if (!(Lq[i].v[j] == 0.0)) reads[j] = true;
+        if (!(K(i, j) == 0.0)) reads[j] = true;
   }
   return reads;
 }
