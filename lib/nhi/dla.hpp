@@ -466,7 +466,9 @@ class DlaStepper {
   //     dL/dq(q_c) = dL/dq(q_c,guess) + c K (q_next - q_guess),  q_next - q_guess = h (v - v_guess)
   // exactly, and the first line of eq. (6) is
   //     (M - h^2 kappa K) v = rhs - h^2 kappa K v_guess - omega(q_{k+1})^T lambda:
-  // the passes use P = (M - h^2 kappa K)^-1 (kept while h does not change)
+  // the passes use P = (M - h^2 kappa K)^-1 (kept for the last two step sizes: a
+  // composition alternates between two, and with one kept the particle's
+  // midpoint triple jump cost 469-487 ns per step against 394 in a scratch run)
   // instead of V(qbar, .) = M^-1, and are then exact in the potential, so
   // the particle's settle like the symmetric rule's (h = 0.2: Newton
   // iterations 1.89 -> 0.004 per step).  At a fixed point the added terms
@@ -533,21 +535,26 @@ class DlaStepper {
       // rule: h = 0.4 / 2^9, rho = 3e-7, 190-215 ns per step either way;
       // h = 0.4 / 2^8, rho = 1.2e-6, plain passes needed a Jet on 32 % of the
       // steps, 284 -> 194 ns with P).
-      if (K_ && h != P_h_) {
-        P_h_ = h;
-        P_ok_ = false;
-        hkK_ = (h * h * kappa_) * *K_;
-        const Mat<double, n, n> MhkK = Minv_ * hkK_;
-        const Mat<double, n, n> G = Mat<double, n, n>::Identity() - MhkK;  // M^-1 (M - h^2 kappa K)
-        const double det = G.determinant();
-        if (MhkK.cwiseAbs().maxCoeff() >= 1e-6 && std::isfinite(det) && std::abs(det) > 0.5) {  // h^2 kappa K small against M
-          P_ = G.inverse() * Minv_;
-          P_ok_ = all_finite(P_);
+      if (K_ && h != curv_[cur_].h) {
+        // Two step sizes kept: a composition's stages alternate between them.
+        cur_ = 1 - cur_;
+        Curvature& c = curv_[cur_];
+        if (h != c.h) {
+          c.h = h;
+          c.ok = false;
+          c.hkK = (h * h * kappa_) * *K_;
+          const Mat<double, n, n> MhkK = Minv_ * c.hkK;
+          const Mat<double, n, n> G = Mat<double, n, n>::Identity() - MhkK;  // M^-1 (M - h^2 kappa K)
+          const double det = G.determinant();
+          if (MhkK.cwiseAbs().maxCoeff() >= 1e-6 && std::isfinite(det) && std::abs(det) > 0.5) {  // h^2 kappa K small against M
+            c.P = G.inverse() * Minv_;
+            c.ok = all_finite(c.P);
+          }
         }
       }
     }
-    const bool curved = K_ && P_ok_;
-    if (curved) PWt = P_ * Wt;
+    const bool curved = K_ && curv_[cur_].ok;
+    if (curved) PWt = curv_[cur_].P * Wt;
     if constexpr (kPassesSolveMultipliers) {
       polish_curved_ = curved;
     }
@@ -635,7 +642,7 @@ class DlaStepper {
           q1 = q + h * VecN(Grhs - GWt * lambda);
           newton_pass = true;
         } else if (curved) {
-          const VecN Prhs = P_ * VecN(rhs - hkK_ * vg);
+          const VecN Prhs = curv_[cur_].P * VecN(rhs - curv_[cur_].hkK * vg);
           Sinv = Mat<double, m, m>(Om * PWt).inverse();
           lambda = Sinv * VecM(Om * Prhs);
           q1 = q + h * VecN(Prhs - PWt * lambda);
@@ -702,7 +709,7 @@ class DlaStepper {
       if (!polish_ok_) return;
       // G x: P x, M^-1 x, or (I + z e_r^T / (1 - z_r)) M^-1 x (next_guess).
       const auto G = [this](const VecN& x) -> VecN {
-        if (polish_curved_) return P_ * x;
+        if (polish_curved_) return curv_[cur_].P * x;
         const VecN y = Minv_ * x;
         if (polish_zr_ < 0) return y;
         return y + y[polish_zr_] * polish_z_;
@@ -767,16 +774,20 @@ class DlaStepper {
   std::optional<VecN> p0_;
   // The curvature of the passes (next_guess): M^-1 on a separable system,
   // kappa = sum_c w_c c (1 - c), K = d(dL/dq)/dq when constant, and
-  // P = (M - h^2 kappa K)^-1, hkK = h^2 kappa K for the step P_h_.
+  // P = (M - h^2 kappa K)^-1, hkK = h^2 kappa K for a step size (curv_).
   Mat<double, n, n> Minv_ = Mat<double, n, n>::Zero();
   double kappa_ = 0;
   bool affine_potential_force_ = false;  // dL/dq affine in q (K constant, maybe 0)
   std::optional<Mat<double, n, n>> K_;   // K when constant and not 0
   mutable typename Map::Problem::Memo omega_memo_;  // omega at the constraint nodes (OmegaMemo)
   mutable Mat<double, n, Map::mc> guess_Wt_ = Mat<double, n, Map::mc>::Zero();  // force_forms(q_{k+1})^T, by next_guess (for the solve and polish())
-  mutable Mat<double, n, n> P_ = Mat<double, n, n>::Zero(), hkK_ = Mat<double, n, n>::Zero();
-  mutable double P_h_ = 0;
-  mutable bool P_ok_ = false;
+  struct Curvature {
+    Mat<double, n, n> P = Mat<double, n, n>::Zero(), hkK = Mat<double, n, n>::Zero();
+    double h = 0;
+    bool ok = false;
+  };
+  mutable Curvature curv_[2];  // for the last two step sizes; curv_[cur_] is this step's
+  mutable int cur_ = 0;
   // Set by start(); zero until then (so that an unstarted stepper copies cleanly).
   VecN q_prev_ = VecN::Zero(), q_curr_ = VecN::Zero(), q_next_ = VecN::Zero(), p_curr_ = VecN::Zero(),
        p_next_ = VecN::Zero(), v0_ = VecN::Zero();
