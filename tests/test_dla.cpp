@@ -268,7 +268,8 @@ TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
     expect_fast_path_exact<TypeParam>(AlphaDiscretization{0.25}, h, 400);
     expect_fast_path_exact<TypeParam>(SymmetricDiscretization{0.25}, h, 400);
   }
-  // The stages of the triple jump (gamma_2 < 0: every other stage turns back).
+  // The stages of the triple jump (gamma_2 < 0: two of every three stages turn
+  // back, and none follows two steps in its own direction).
   const double g1 = 1.0 / (2.0 - std::cbrt(2.0));
   for (double h : {0.2, 0.02}) {
     expect_fast_path_exact<TypeParam>(AlphaDiscretization{0.5}, h, 600, {g1, 1.0 - 2.0 * g1, g1});

@@ -258,16 +258,17 @@ class DiscreteGradientStepper {
     Vec<double, 2 * n> f_prev, g_prev;
     int mix_from = -1;  // the pass from which the passes are mixed (-1: not)
     // F affine in q (see the constructor): Q = (I - (h^2/4) K M^-1)^-1 and
-    // M^-1 Q, kept for the last two step sizes (a composition alternates
-    // between two: its triple jump 956-972 -> 926-944 ns per step on the
-    // particle in a scratch run, with one).
+    // M^-1 Q, kept for the last two step sizes (the triple jump and Suzuki's
+    // composition alternate between two: the particle's triple jump cost
+    // 956-972 ns per step with one kept, 926-944 with two, in a scratch run).
     // Only where a plain pass gains less than ~2000 (its factor is about
     // rho = (h^2/4) |K M^-1|): below, the plain passes settle in about as
     // many passes as the curved ones and the hand-over (measured on the
     // particle: h = 0.025, rho = 3e-4, the same 426 ns per step either way;
     // h = 0.0125: 371 ns plain, 438 curved; h = 0.05: 475 plain, 390 curved).
     if (K_ && h != curv_[cur_].h) {
-      // Two step sizes kept: a composition's stages alternate between them.
+      // Two step sizes kept: the triple jump's and Suzuki's stages alternate
+      // between two (the order-6 composition's five still miss).
       cur_ = 1 - cur_;
       Curvature& cv = curv_[cur_];
       if (h != cv.h) {

@@ -398,8 +398,8 @@ class DlaStepper {
     h_ = h;
     map_.set_h(h);
     // (Only a guess the passes refined is worth the check: where the passes
-    // do not settle, the stages of a composition that turn back get the
-    // plain extrapolation, refines().)
+    // do not settle, the stages of a composition, none of which follows two
+    // steps in its own direction, get the plain extrapolation, refines().)
     const bool check = settled || (accepted_last && predicted);
     StepSummary st = map_.step(
         q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_, check,
@@ -466,9 +466,10 @@ class DlaStepper {
   //     dL/dq(q_c) = dL/dq(q_c,guess) + c K (q_next - q_guess),  q_next - q_guess = h (v - v_guess)
   // exactly, and the first line of eq. (6) is
   //     (M - h^2 kappa K) v = rhs - h^2 kappa K v_guess - omega(q_{k+1})^T lambda:
-  // the passes use P = (M - h^2 kappa K)^-1 (kept for the last two step sizes: a
-  // composition alternates between two, and with one kept the particle's
-  // midpoint triple jump cost 469-487 ns per step against 394 in a scratch run)
+  // the passes use P = (M - h^2 kappa K)^-1 (kept for the last two step sizes:
+  // the triple jump and Suzuki's composition alternate between two, and with
+  // one kept the particle's midpoint triple jump cost 469-487 ns per step,
+  // with two 394, in a scratch run)
   // instead of V(qbar, .) = M^-1, and are then exact in the potential, so
   // the particle's settle like the symmetric rule's (h = 0.2: Newton
   // iterations 1.89 -> 0.004 per step).  At a fixed point the added terms
@@ -536,7 +537,8 @@ class DlaStepper {
       // h = 0.4 / 2^8, rho = 1.2e-6, plain passes needed a Jet on 32 % of the
       // steps, 284 -> 194 ns with P).
       if (K_ && h != curv_[cur_].h) {
-        // Two step sizes kept: a composition's stages alternate between them.
+        // Two step sizes kept: the triple jump's and Suzuki's stages alternate
+        // between two (the order-6 composition's five still miss).
         cur_ = 1 - cur_;
         Curvature& c = curv_[cur_];
         if (h != c.h) {
@@ -745,7 +747,7 @@ class DlaStepper {
   // chaotic oscillator 4022-4185 -> 2446-2463 and 5442-5516 -> 529-536).  On
   // the sleigh (omega reads theta, the force turns it) the passes at a turn
   // made its triple jump slower (midpoint 359-387 -> 542-562 ns): there the
-  // stages that turn back keep the plain extrapolation.  (Refining at a turn
+  // stages keep the plain extrapolation.  (Refining at a turn
   // had once cost the robot's triple jump 4.1 iterations per stage, with the
   // passes before those that are Newton steps in its potential.)
   bool refines(double h) const { return one_direction(h) || (passes_settle_ && steps_ >= 2); }
