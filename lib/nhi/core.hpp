@@ -79,6 +79,34 @@ inline T divide(const T& x, double s) {
   }
 }
 
+// What a stepper derives from the step size h (a matrix to invert, say), kept
+// for the last two sizes: the stages of the triple jump and of Suzuki's
+// composition alternate between two (the order-6 composition's five still
+// miss).  at(h, make) returns the entry for h, made by make(h) when neither
+// slot holds it (into the one not used last); current() the last one asked
+// for (a default E before any).
+template <class E>
+class StepSizeCache {
+ public:
+  template <class Make>
+  const E& at(double h, Make&& make) {
+    if (!(h == h_[cur_])) {
+      cur_ = 1 - cur_;
+      if (!(h == h_[cur_])) {
+        h_[cur_] = h;
+        entry_[cur_] = make(h);
+      }
+    }
+    return entry_[cur_];
+  }
+  const E& current() const { return entry_[cur_]; }
+
+ private:
+  E entry_[2] = {};
+  double h_[2] = {0, 0};
+  int cur_ = 0;
+};
+
 // The double value at the bottom of a (possibly nested) Jet.
 template <class T>
 inline double value_of(const T& x) {

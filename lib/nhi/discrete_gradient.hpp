@@ -266,15 +266,10 @@ class DiscreteGradientStepper {
     // many passes as the curved ones and the hand-over (measured on the
     // particle: h = 0.025, rho = 3e-4, the same 426 ns per step either way;
     // h = 0.0125: 371 ns plain, 438 curved; h = 0.05: 475 plain, 390 curved).
-    if (K_ && h != curv_[cur_].h) {
-      // Two step sizes kept: the triple jump's and Suzuki's stages alternate
-      // between two (the order-6 composition's five still miss).
-      cur_ = 1 - cur_;
-      Curvature& cv = curv_[cur_];
-      if (h != cv.h) {
-        cv.h = h;
-        cv.ok = false;
-        const Mat<double, n, n> hKM = (0.25 * h * h) * (*K_ * Minv_);
+    if (K_) {
+      curv_.at(h, [this](double hh) {
+        Curvature cv;
+        const Mat<double, n, n> hKM = (0.25 * hh * hh) * (*K_ * Minv_);
         const Mat<double, n, n> G = Mat<double, n, n>::Identity() - hKM;
         const double det = G.determinant();
         if (hKM.cwiseAbs().maxCoeff() >= 5e-4 && std::isfinite(det) && std::abs(det) > 0.5) {  // (h^2/4) K small against M
@@ -282,11 +277,12 @@ class DiscreteGradientStepper {
           cv.MQ = Minv_ * cv.Q;
           cv.ok = all_finite(cv.Q);
         }
-      }
+        return cv;
+      });
     }
-    const bool curved = allow_curved && K_ && curv_[cur_].ok;
-    const Mat<double, n, n>& Q = curv_[cur_].Q;
-    const Mat<double, n, n>& MQ = curv_[cur_].MQ;
+    const bool curved = allow_curved && K_ && curv_.current().ok;
+    const Mat<double, n, n>& Q = curv_.current().Q;
+    const Mat<double, n, n>& MQ = curv_.current().MQ;
     for (int pass = 0; pass < kPasses; ++pass) {
       // Dq = -F(qbar) + c dq and the frozen c dp, with the sizes sq, sp of
       // the residual's rows (DiscreteGradientProblem::discrete_gradient).
@@ -468,11 +464,9 @@ class DiscreteGradientStepper {
   Mat<double, n, n> Minv_ = Mat<double, n, n>::Zero();
   struct Curvature {
     Mat<double, n, n> Q = Mat<double, n, n>::Zero(), MQ = Mat<double, n, n>::Zero();
-    double h = 0;
     bool ok = false;
   };
-  mutable Curvature curv_[2];  // for the last two step sizes; curv_[cur_] is this step's
-  mutable int cur_ = 0;
+  mutable StepSizeCache<Curvature> curv_;  // current(): this step's
 };
 
 // The method table's entry (methods.hpp): "discrete_gradient", symmetric, so composable.

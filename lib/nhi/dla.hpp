@@ -536,15 +536,10 @@ class DlaStepper {
       // rule: h = 0.4 / 2^9, rho = 3e-7, 190-215 ns per step either way;
       // h = 0.4 / 2^8, rho = 1.2e-6, plain passes needed a Jet on 32 % of the
       // steps, 284 -> 194 ns with P).
-      if (K_ && h != curv_[cur_].h) {
-        // Two step sizes kept: the triple jump's and Suzuki's stages alternate
-        // between two (the order-6 composition's five still miss).
-        cur_ = 1 - cur_;
-        Curvature& c = curv_[cur_];
-        if (h != c.h) {
-          c.h = h;
-          c.ok = false;
-          c.hkK = (h * h * kappa_) * *K_;
+      if (K_) {
+        curv_.at(h, [this](double hh) {
+          Curvature c;
+          c.hkK = (hh * hh * kappa_) * *K_;
           const Mat<double, n, n> MhkK = Minv_ * c.hkK;
           const Mat<double, n, n> G = Mat<double, n, n>::Identity() - MhkK;  // M^-1 (M - h^2 kappa K)
           const double det = G.determinant();
@@ -552,11 +547,12 @@ class DlaStepper {
             c.P = G.inverse() * Minv_;
             c.ok = all_finite(c.P);
           }
-        }
+          return c;
+        });
       }
     }
-    const bool curved = K_ && curv_[cur_].ok;
-    if (curved) PWt = curv_[cur_].P * Wt;
+    const bool curved = K_ && curv_.current().ok;
+    if (curved) PWt = curv_.current().P * Wt;
     if constexpr (kPassesSolveMultipliers) {
       polish_curved_ = curved;
     }
@@ -644,7 +640,7 @@ class DlaStepper {
           q1 = q + h * VecN(Grhs - GWt * lambda);
           newton_pass = true;
         } else if (curved) {
-          const VecN Prhs = curv_[cur_].P * VecN(rhs - curv_[cur_].hkK * vg);
+          const VecN Prhs = curv_.current().P * VecN(rhs - curv_.current().hkK * vg);
           Sinv = Mat<double, m, m>(Om * PWt).inverse();
           lambda = Sinv * VecM(Om * Prhs);
           q1 = q + h * VecN(Prhs - PWt * lambda);
@@ -711,7 +707,7 @@ class DlaStepper {
       if (!polish_ok_) return;
       // G x: P x, M^-1 x, or (I + z e_r^T / (1 - z_r)) M^-1 x (next_guess).
       const auto G = [this](const VecN& x) -> VecN {
-        if (polish_curved_) return curv_[cur_].P * x;
+        if (polish_curved_) return curv_.current().P * x;
         const VecN y = Minv_ * x;
         if (polish_zr_ < 0) return y;
         return y + y[polish_zr_] * polish_z_;
@@ -785,11 +781,9 @@ class DlaStepper {
   mutable Mat<double, n, Map::mc> guess_Wt_ = Mat<double, n, Map::mc>::Zero();  // force_forms(q_{k+1})^T, by next_guess (for the solve and polish())
   struct Curvature {
     Mat<double, n, n> P = Mat<double, n, n>::Zero(), hkK = Mat<double, n, n>::Zero();
-    double h = 0;
     bool ok = false;
   };
-  mutable Curvature curv_[2];  // for the last two step sizes; curv_[cur_] is this step's
-  mutable int cur_ = 0;
+  mutable StepSizeCache<Curvature> curv_;  // current(): this step's
   // Set by start(); zero until then (so that an unstarted stepper copies cleanly).
   VecN q_prev_ = VecN::Zero(), q_curr_ = VecN::Zero(), q_next_ = VecN::Zero(), p_curr_ = VecN::Zero(),
        p_next_ = VecN::Zero(), v0_ = VecN::Zero();
