@@ -45,6 +45,55 @@ TYPED_TEST(NewMethodsTest, InverseLegendreMapIsTheGenericOne) {
   }
 }
 
+// The velocity form that the mp06 stepper solves on a non-separable system
+// (Mp06Problem: unknowns v1 and lambda, q1 and p1 explicit in v1) is the
+// phase form of the equations as stated (Mp06PhaseProblem: q1, p1, lambda),
+// on every scene with random parameters and states, from h = 0.2 down to
+// 1e-7: the same step to round-off of q1, p1 and the impulse h lambda, and
+// the phase form's own residual at the velocity form's step within its
+// tolerance.
+TYPED_TEST(NewMethodsTest, Mp06VelocityFormIsThePhaseForm) {
+  using S = TypeParam;
+  constexpr int n = S::n, m = S::m;
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst_q = 0, worst_p = 0, worst_l = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const S sys = randomized_system<S>(rng);
+    Vec<double, n> q0, p0;
+    for (int i = 0; i < n; ++i) {
+      q0[i] = u(rng);
+      p0[i] = u(rng);
+    }
+    for (const double h : {0.2, 1e-3, 1e-7}) {
+      const Mp06PhaseProblem<S> phase(sys, h, q0, p0);
+      Vec<double, 2 * n> y = phase.guess(q0, Vec<double, m>::Zero());
+      Vec<double, m> lp = Vec<double, m>::Zero();
+      ASSERT_TRUE(NewtonSolver<Mp06PhaseProblem<S>>(phase).solve(&y, &lp).ok()) << trial << " h " << h;
+      const Mp06Problem<S> vel(sys, h, q0, p0);
+      Vec<double, n> v1 = vel.guess(q0, Vec<double, m>::Zero());
+      Vec<double, m> lv = Vec<double, m>::Zero();
+      ASSERT_TRUE(NewtonSolver<Mp06Problem<S>>(vel).solve(&v1, &lv).ok()) << trial << " h " << h;
+      Vec<double, n> q1, p1;
+      vel.finish(v1, lv, &q1, &p1);
+      const Vec<double, n> qp = y.template head<n>(), pp = y.template tail<n>();
+      const double sq = 1 + qp.cwiseAbs().maxCoeff(), sp = 1 + pp.cwiseAbs().maxCoeff();
+      worst_q = std::max(worst_q, (q1 - qp).cwiseAbs().maxCoeff() / sq);
+      worst_p = std::max(worst_p, (p1 - pp).cwiseAbs().maxCoeff() / sp);
+      worst_l = std::max(worst_l, h * (lv - lp).cwiseAbs().maxCoeff() / sp);
+      Vec<double, 2 * n> yv;
+      yv << q1, p1;
+      EXPECT_LE(NewtonSolver<Mp06PhaseProblem<S>>(phase).relative_residual(yv, lv), SolverOptions{}.tolerance)
+          << trial << " h " << h;
+    }
+  }
+  EXPECT_LE(worst_q, 64 * kEps);
+  EXPECT_LE(worst_p, 64 * kEps);
+  EXPECT_LE(worst_l, 64 * kEps);
+  std::printf("[ %s ] mp06 velocity form - phase form, in eps: q1 %.2g, p1 %.2g, h lambda %.2g\n", S::name,
+              worst_q / kEps, worst_p / kEps, worst_l / kEps);
+}
+
 // mp06's general form (unknowns q1, p1, lambda) and its reduced form (lambda
 // only, for separable systems) are the same map: 50 steps agree to round-off.
 template <class S>

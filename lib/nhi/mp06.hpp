@@ -10,15 +10,18 @@
 // returns to (q0, p0): the adjoint exchanges the two half steps, and the
 // multiplier of the reverse step is the same lambda) and of order 2.
 //
-// Two forms of the same solve (NewtonSolver, solver.hpp):
-//  - general: unknowns y = (q1, p1), multipliers lambda; the constraint force
-//    h omega(q_half)^T lambda has fixed rows during the step (q_half is explicit),
-//    which is the saddle-point form the solver exploits;
+// The same equations in three forms (NewtonSolver, solver.hpp):
+//  - phase form (Mp06PhaseProblem): unknowns y = (q1, p1), multipliers lambda;
+//    the constraint force h omega(q_half)^T lambda has fixed rows during the step
+//    (q_half is explicit), which is the saddle-point form the solver exploits;
+//  - velocity form (Mp06Problem, what the stepper solves in general): unknowns
+//    v1 = V(q1, p1) and lambda, with q1 = q_half + (h/2) v1 and
+//    p1 = dL/dqdot(q1, v1) explicit, half the unknowns of the phase form;
 //  - separable systems (L = 1/2 v^T M v - U(q), M constant): F does not depend
 //    on p and V not on q, so p1 and q1 are explicit, affine in lambda, and the
 //    step is m equations omega(q1(lambda)) V(p1(lambda)) = 0 in lambda alone.
-// tests/test_new_methods.cpp checks that both forms give the same step, and
-// both against a closed-form step of the particle.
+// tests/test_new_methods.cpp checks that the three forms give the same step,
+// and the separable one against a closed-form step of the particle.
 #pragma once
 
 #include <string>
@@ -30,9 +33,11 @@
 
 namespace nhi {
 
-// General form: y = (q1, p1), lambda; rows (q equation, p equation, constraint).
+// General form, as the equations are stated: y = (q1, p1), lambda; rows (q
+// equation, p equation, constraint).  The stepper solves the eliminated form
+// below; tests/test_new_methods.cpp checks that the two give the same step.
 template <class S>
-struct Mp06Problem {
+struct Mp06PhaseProblem {
   static constexpr int n = S::n, m = S::m;
   static constexpr int ny = 2 * n, nl = m;
   using VecN = Vec<double, n>;
@@ -42,7 +47,7 @@ struct Mp06Problem {
   VecN p0, q_half, F0;     // F0 = F(q_half, p0)
   Mat<double, ny, nl> W_t; // [0; h omega(q_half)^T]
 
-  Mp06Problem(const S& s, double hh, const VecN& q0, const VecN& p) : sys(s), h(hh), p0(p) {
+  Mp06PhaseProblem(const S& s, double hh, const VecN& q0, const VecN& p) : sys(s), h(hh), p0(p) {
     q_half = q0 + 0.5 * h * velocity<S, double>(sys, q0, p0);
     F0 = force<S, double>(sys, q_half, p0);
     W_t.setZero();
@@ -103,6 +108,87 @@ struct Mp06Problem {
     y << q_half + 0.5 * h * velocity<S, double>(sys, q_half, p1), p1;
     (void)q0;
     return y;
+  }
+};
+
+// General form in the velocity (what the stepper solves for a system that is
+// not separable).  Take y = v1 = V(q1, p1) as the unknown: the q equation is
+// then q1 = q_half + (h/2) v1, and since V inverts the Legendre map,
+// p1 = dL/dqdot(q1, v1); both explicit, so the step is n + m equations in v1
+// and lambda:
+//     dL/dqdot(q1, v1) - p0 - (h/2) [F(q_half, p0) + F(q_half, p1)] - h omega(q_half)^T lambda = 0
+//     omega(q1) v1 = 0,      q1 = q_half + (h/2) v1,  p1 = dL/dqdot(q1, v1)
+// the saddle-point form of NewtonSolver with the fixed Wt = h omega(q_half)^T,
+// as the DLA's (dla.hpp).  Half the unknowns of the phase form, so Jets of n
+// derivatives instead of 2n and, for n, m <= 4, the closed-form Schur solve
+// instead of pivoted LU of the whole matrix (issue 13: on
+// contact_oscillator_nr perf put 23 % of a step in that LU and 40 % in the
+// Jet evaluation).  The unknown is v1, not q1: with q1, v1 = 2 (q1 - q_half) / h
+// would carry the round-off of q1 times 2/h into p1 and lambda at small h.
+template <class S>
+struct Mp06Problem {
+  static constexpr int n = S::n, m = S::m;
+  static constexpr int ny = n, nl = m;
+  using VecN = Vec<double, n>;
+
+  const S& sys;
+  double h;
+  VecN p0, q_half, F0;     // F0 = F(q_half, p0)
+  Mat<double, ny, nl> W_t; // h omega(q_half)^T
+
+  Mp06Problem(const S& s, double hh, const VecN& q0, const VecN& p) : sys(s), h(hh), p0(p) {
+    q_half = q0 + 0.5 * h * velocity<S, double>(sys, q0, p0);
+    F0 = force<S, double>(sys, q_half, p0);
+    W_t = h * sys.template omega<double>(q_half).transpose();
+  }
+
+  const Mat<double, ny, nl>& Wt() const { return W_t; }
+
+  Vec<double, ny> y_scale(const Vec<double, ny>& v1) const { return v1.cwiseAbs(); }
+
+  template <class T>
+  void residual(const Vec<T, ny>& v1, const Vec<T, nl>& lambda, Vec<T, ny + nl>* r,
+                Vec<double, ny + nl>* terms) const {
+    Vec<T, n> q1;
+    for (int i = 0; i < n; ++i) q1[i] = cst<T>(q_half[i]) + scale(v1[i], 0.5 * h);
+    Vec<T, n> Lq, p1;
+    lagrangian_partials(sys, q1, v1, &Lq, &p1);  // p1 = dL/dqdot(q1, v1)
+    const Vec<T, n> F1 = force(sys, Vec<T, n>(q_half.template cast<T>()), p1);
+    const Mat<T, m, n> W1 = sys.template omega<T>(q1);
+    for (int i = 0; i < n; ++i) {
+      T fc = cst<T>(0.0);
+      double fscale = 0;
+      for (int a = 0; a < m; ++a) {
+        fc += cst<T>(W_t(i, a)) * lambda[a];
+        fscale += std::abs(W_t(i, a) * value_of(lambda[a]));
+      }
+      // p1 = p0 + (h/2)(F(q_half, p0) + F(q_half, p1)) + h omega(q_half)^T lambda
+      (*r)[i] = p1[i] - cst<T>(p0[i]) - cst<T>(0.5 * h) * (cst<T>(F0[i]) + F1[i]) - fc;
+      if (terms)
+        (*terms)[i] = std::abs(value_of(p1[i])) + std::abs(p0[i]) +
+                      std::abs(0.5 * h) * (std::abs(F0[i]) + std::abs(value_of(F1[i]))) + fscale;
+    }
+    for (int a = 0; a < m; ++a) {  // omega(q1) v1 = 0
+      T c = cst<T>(0.0);
+      double cs = 0;
+      for (int j = 0; j < n; ++j) {
+        c += W1(a, j) * v1[j];
+        cs += std::abs(value_of(W1(a, j)) * value_of(v1[j]));
+      }
+      (*r)[ny + a] = c;
+      if (terms) (*terms)[ny + a] = cs;
+    }
+  }
+
+  // q1 = q_half + (h/2) v1 and p1 = dL/dqdot(q1, v1) from the solution.
+  void finish(const Vec<double, ny>& v1, const Vec<double, nl>&, VecN* q1, VecN* p1) const {
+    *q1 = q_half + 0.5 * h * v1;
+    *p1 = momentum(sys, *q1, v1);
+  }
+  // The phase form's start: p1 by an explicit step with the last multipliers,
+  // v1 = V(q_half, p1).
+  Vec<double, ny> guess(const VecN&, const Vec<double, nl>& lambda) const {
+    return velocity<S, double>(sys, q_half, VecN(p0 + h * F0 + W_t * lambda));
   }
 };
 
@@ -238,7 +324,7 @@ class Mp06Stepper {
       }
     } else {
       const Mp06Problem<S> prob(sys_, h, q0, p0);
-      Vec<double, 2 * n> y = prob.guess(q0, *lambda);
+      Vec<double, n> y = prob.guess(q0, *lambda);
       VecM l = *lambda;
       s = NewtonSolver<Mp06Problem<S>>(prob, options_).solve(&y, &l);
       if (s.ok()) {
