@@ -33,8 +33,8 @@
 
 namespace nhi {
 
-// General form, as the equations are stated: y = (q1, p1), lambda; rows (q
-// equation, p equation, constraint).  The stepper solves the eliminated form
+// Phase form, the equations as stated: y = (q1, p1), lambda; rows (q
+// equation, p equation, constraint).  The stepper solves the velocity form
 // below; tests/test_new_methods.cpp checks that the two give the same step.
 template <class S>
 struct Mp06PhaseProblem {
