@@ -132,8 +132,9 @@ TEST(Mp06, VelocityFormKeepsThePhaseFormEnergyRoundOff) {
   EXPECT_LE(drift_phase, 1e-12);  // both at round-off: order 6 at h = 0.0125
 }
 
-// mp06's general form (unknowns q1, p1, lambda) and its reduced form (lambda
-// only, for separable systems) are the same map: 50 steps agree to round-off.
+// mp06's general form (the velocity form, unknowns v1 and lambda) and its
+// reduced form (lambda only, for separable systems) are the same map: 50 steps
+// agree to round-off.
 template <class S>
 class SeparableTest : public ::testing::Test {};
 TYPED_TEST_SUITE(SeparableTest, SeparableSystems);

@@ -119,7 +119,7 @@ struct Mp06PhaseProblem {
 //     dL/dqdot(q1, v1) - p0 - (h/2) [F(q_half, p0) + F(q_half, p1)] - h omega(q_half)^T lambda = 0
 //     omega(q1) v1 = 0,      q1 = q_half + (h/2) v1,  p1 = dL/dqdot(q1, v1)
 // the saddle-point form of NewtonSolver with the fixed Wt = h omega(q_half)^T,
-// as the DLA's (dla.hpp).  Half the unknowns of the phase form, so Jets of n
+// as the DLA's (dla.hpp).  n unknowns y instead of the phase form's 2n, so Jets of n
 // derivatives instead of 2n and, for n, m <= 4, the closed-form Schur solve
 // instead of pivoted LU of the whole matrix (issue 13: on
 // contact_oscillator_nr perf put 23 % of a step in that LU and 40 % in the
@@ -182,7 +182,8 @@ struct Mp06Problem {
 
   // (q1, p1) from the solution by the phase form's own equations, one
   // explicit pass: p1 from the momentum equation, with F at the Legendre
-  // momentum dL/dqdot(q1, v1), then q1 = q_half + (h/2) V(q1, p1).  Changes
+  // momentum dL/dqdot(qv, v1), then q1 = q_half + (h/2) V(qv, p1), where
+  // qv = q_half + (h/2) v1 is the velocity form's q1.  Changes
   // of round-off size, but taking p1 = dL/dqdot(q1, v1) itself biased the
   // energy: on contact_oscillator_nr, mp06 + order 6 at h = 0.0125 drifted by
   // 1.2e-10 over t = 1000 against 7.6e-13 for the phase form's solve, and
