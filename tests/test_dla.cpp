@@ -207,8 +207,9 @@ void expect_fast_path_exact(const D& disc, double h, long steps, const std::vect
   }
   // Passes that are Newton steps in a potential of one coordinate reach the
   // step's solution too: Newton then has nothing left to iterate.
-  if (st.passes_newton_in_potential() && Mp06Stepper<S>::explicit_structure(sys))
+  if (st.passes_newton_in_potential() && Mp06Stepper<S>::explicit_structure(sys)) {
     EXPECT_GE(no_iteration, 0.9 * (steps - 3)) << what;
+  }
 }
 
 // The stepper does not evaluate omega again at a constraint node whose
@@ -236,7 +237,9 @@ TYPED_TEST(DlaTest, OmegaMemoIsOmegaBitForBit) {
         q2[j] += u(rng);
         const Mat<double, m, n> W2 = sys.template omega<double>(q2);
         const bool same = (W2.array() == W.array()).all();
-        if (!memo.reads[j]) EXPECT_TRUE(same) << S::name << ": omega depends on q_" << j << ", not listed";
+        if (!memo.reads[j]) {
+          EXPECT_TRUE(same) << S::name << ": omega depends on q_" << j << ", not listed";
+        }
         EXPECT_TRUE((memo.at(sys, 0, q2).array() == W2.array()).all()) << S::name << " state " << k << " q_" << j;
         EXPECT_TRUE((memo.at(sys, 0, q).array() == W.array()).all()) << S::name << " state " << k << " back";
       }
@@ -337,8 +340,9 @@ template <class S, class D>
 void expect_accepted_steps_rounded(const D& disc, double h) {
   double share = 0;
   EXPECT_LE(mean_correction_of_accepted_steps<S>(disc, h, 10000, &share), 0.3) << disc.name() << " h " << h;
-  if (DlaStepper<S, D>::kPassesSolveMultipliers && h < 0.01)
+  if (DlaStepper<S, D>::kPassesSolveMultipliers && h < 0.01) {
     EXPECT_GE(share, 0.5) << disc.name() << " h " << h << ": the check was not reached";
+  }
 }
 
 TYPED_TEST(DlaTest, AcceptedGuessIsTheStepSolutionRounded) {

@@ -168,8 +168,9 @@ TYPED_TEST(SeparableTest, Mp06ExplicitStepIsTheNewtonStep) {
   const S sys = make_system<S>();
   const bool is_explicit = Mp06Stepper<S, true>::explicit_structure(sys);
   const std::string name = S::name;
-  if (name == "particle" || name == "robot" || name == "contact_oscillator" || name == "chaotic_oscillator")
+  if (name == "particle" || name == "robot" || name == "contact_oscillator" || name == "chaotic_oscillator") {
     EXPECT_TRUE(is_explicit) << name;
+  }
   if constexpr (std::is_same_v<S, Sleigh>) {
     EXPECT_FALSE(is_explicit);
     Sleigh knife = sys;
@@ -267,14 +268,17 @@ TYPED_TEST(SeparableTest, DiscreteGradientPassesSolveTheStep) {
     EXPECT_LE(worst_r, 64 * kEps) << S::name << " h " << h;
     EXPECT_LE(worst_dz, 1e-12) << S::name << " h " << h;
     EXPECT_LE(worst_impulse, 1e-12) << S::name << " h " << h;
-    if (h > 0 && h <= 0.2) EXPECT_GE(no_jacobian, 0.9 * steps) << S::name << " h " << h;
+    if (h > 0 && h <= 0.2) {
+      EXPECT_GE(no_jacobian, 0.9 * steps) << S::name << " h " << h;
+    }
     // F affine in q, and constraint rows that read only coordinates the
     // constraint force does not move: the passes settle at every h here,
     // exact in the force where a plain pass gains little (h >= 0.05 on the
     // particle), plain below (the particle took a Jet on 19 % of its steps at
     // h = 0.4 before).
-    if (st.passes_exact_in_force() && Mp06Stepper<S>::explicit_structure(sys))
+    if (st.passes_exact_in_force() && Mp06Stepper<S>::explicit_structure(sys)) {
       EXPECT_GE(no_jacobian, 0.99 * steps) << S::name << " h " << h;
+    }
   }
 }
 
@@ -460,11 +464,16 @@ TYPED_TEST(NewMethodsTest, FailuresGoThroughTheSharedPath) {
         st->start(S::default_q0(), S::default_v0());
         for (long k = 1; k <= 10 && !first_fail; ++k) {
           const StepSummary sum = st->step(0.2);
-          if (!sum.ok()) first_fail = k;
-          else EXPECT_EQ(sum.relative_residual, 0.0) << spec.label() << " step " << k << " met an unreachable tolerance";
+          if (!sum.ok()) {
+            first_fail = k;
+          } else {
+            EXPECT_EQ(sum.relative_residual, 0.0) << spec.label() << " step " << k << " met an unreachable tolerance";
+          }
         }
       }
-      if (std::string(kind) != "mp06") EXPECT_EQ(first_fail, 1) << spec.label();
+      if (std::string(kind) != "mp06") {
+        EXPECT_EQ(first_fail, 1) << spec.label();
+      }
       if (first_fail == 0) {
         EXPECT_TRUE(rep.ok) << spec.label();
       } else {
