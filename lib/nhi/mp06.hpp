@@ -364,15 +364,12 @@ class Mp06Stepper {
     } else {
       W = sys_.template omega<double>(qn);
     }
+    VecM r, terms;
+    mp06_constraint_rows(W, vn, 0, &r, &terms);
     double rel = 0;
     for (int a = 0; a < m; ++a) {
-      double r = 0, terms = 0;
-      for (int j = 0; j < n; ++j) {
-        r += W(a, j) * vn[j];
-        terms += std::abs(W(a, j) * vn[j]);
-      }
-      if (!std::isfinite(r)) return false;
-      rel = std::max(rel, r == 0 ? 0.0 : std::abs(r) / std::max(terms, std::numeric_limits<double>::min()));
+      if (!std::isfinite(r[a])) return false;
+      rel = std::max(rel, r[a] == 0 ? 0.0 : std::abs(r[a]) / std::max(terms[a], std::numeric_limits<double>::min()));
     }
     if (!(rel <= options_.tolerance)) return false;
     *q1 = qn;
