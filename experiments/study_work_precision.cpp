@@ -19,6 +19,7 @@
 #include <boost/numeric/odeint.hpp>
 
 #include <algorithm>
+#include <string>
 
 #include "study.hpp"
 
@@ -39,7 +40,23 @@ constexpr double kT_energy_short = 100.0;  // the same run's max |E - E0| over [
 constexpr double kT_long = 1e6;
 const std::vector<std::string> kLongScenes = {"particle"};
 constexpr double kSelfTimed = 0.5;  // s (see cpu_energy below)
+// Fixed steps h = 0.4 / 2^j, j = 0 ... kFinestJ; tolerances 10^-e, e = kLoosestTol
+// ... kTightestTolReference (CVODE) or kTightestTolPairs (the explicit pairs).
+// Until issue 13 second-order methods went on to j = 9 and order 4 and
+// energy-preserving ones to j = 6: in 6fc3f85's run none of those finer points
+// was on any scene's cost-error front (either error measure, any horizon) and
+// without them no row of summarize.sh's which-method-when table changed, while
+// they took about a third of the study's CPU time (a second-order method's run
+// at h = 0.4/2^9 over T = 10^4 is 1.3e7 steps).  Order 6 reaches the round-off
+// floor by j = 5.
+constexpr int kFinestJ = 5;
+constexpr int kLoosestTol = 3, kTightestTolReference = 12, kTightestTolPairs = 13;
 volatile double g_sink = 0;  // keeps timed runs from being optimized away
+
+// "1e-3 ... 1e-12": the tolerances 10^-e, e = kLoosestTol ... tightest.
+std::string tol_range(int tightest) {
+  return "1e-" + std::to_string(kLoosestTol) + " ... 1e-" + std::to_string(tightest);
+}
 
 template <class S>
 using State = std::array<double, 2 * S::n>;
@@ -165,30 +182,23 @@ int main(int argc, char** argv) {
   const auto fixed = study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
   const auto reference = study::methods([](const nhi::StudyMethod& m) { return m.spec.kind == "benchmark" && !m.external; });
   const auto external = study::methods([](const nhi::StudyMethod& m) { return m.external; });
-  // h = 0.4 / 2^j, j = 0 ... 5, for every fixed-step method.  Until issue 13
-  // second-order methods went on to j = 9 and order 4 and energy-preserving
-  // ones to j = 6: in 6fc3f85's run none of those finer points was on any
-  // scene's cost-error front (either error measure, any horizon) and without
-  // them no row of summarize.sh's which-method-when table changed, while they
-  // took about a third of the study's CPU time (a second-order step at
-  // h = 0.4/2^9 over T = 10^4 is 1.3e7 steps).  Order 6 reaches the round-off
-  // floor by j = 5.
-  constexpr int kFinestJ = 5;
+  // Every fixed-step method over the same h (see kFinestJ).
   auto configs_for = [&](const auto&) {
     std::vector<Config> configs;
     for (int j = 0; j <= kFinestJ; ++j)
       for (const auto& m : fixed) configs.push_back({m, 0.4 / (1 << j)});
-    for (int e = 3; e <= 12; ++e)
+    for (int e = kLoosestTol; e <= kTightestTolReference; ++e)
       for (const auto& m : reference) configs.push_back({m, std::pow(10.0, -e)});
-    for (int e = 3; e <= 13; ++e)
+    for (int e = kLoosestTol; e <= kTightestTolPairs; ++e)
       for (const auto& m : external) configs.push_back({m, std::pow(10.0, -e)});
     return configs;
   };
   json result = {{"study", "work_precision"},
                  {"config", {{"T_final_error", kT_final}, {"T_energy", kT_energy}, {"T_energy_short", kT_energy_short},
                              {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
-                             {"h_fixed", "0.4 / 2^j, j = 0 ... 5 (fixed-step methods)"},
-                             {"tolerances", "1e-3 ... 1e-12 (the reference solution), 1e-3 ... 1e-13 (the explicit pairs)"},
+                             {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods)"},
+                             {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
+                                                tol_range(kTightestTolPairs) + " (the explicit pairs)"},
                              {"cpu", "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms; for fixed-step methods cpu_energy is cpu_energy_short times T_energy / T_energy_short (the same steps, 100 times as many); for the reference solution (CVODE, output every 0.1) cpu_energy is the CPU time of the diagnosed run itself when that took >= 0.5 s"},
                              {"energy_error", "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output point every 0.1 (CVODE)"}, {"energy_error_short", "the same over [0, T_energy_short]"},
                              {"T_long", kT_long}, {"long_scenes", kLongScenes},
