@@ -35,7 +35,8 @@ namespace nhi {
 
 // The constraint rows omega(q1) v1 = 0 (eq. 4.18's last line) into r from
 // row `first`, with the size of each row's terms (|omega_aj v_j| summed) for
-// the solver's residual scale; shared by the three forms below.
+// the solver's residual scale; shared by the three forms below and by
+// Mp06Stepper::explicit_map's residual check.
 template <class T, int m, int n, int N>
 void mp06_constraint_rows(const Mat<T, m, n>& W1, const Vec<T, n>& v1, int first, Vec<T, N>* r,
                           Vec<double, N>* terms) {
