@@ -7,11 +7,19 @@ set output out
 # Columns h, error of method i if its family is (want = 1) or is not (want = 0) "isolation".
 m(i, want) = sprintf("< jq -r '.scenes.%s.methods[%d] | select((.family == \"isolation\") == %s) | [.h, .error] | transpose[] | select(.[1] != null) | @tsv' %s", scene, i, want ? "true" : "false", file)
 # (fitted_order is null where no two errors above round-off remain: "p = -")
-label(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label) (p = \\(.fitted_order | if type == \"number\" then (. * 100 | round / 100) else \"-\" end))\"' %s", scene, i, file))
-family(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].family' %s", scene, i, file))
+label_of(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label) (p = \\(.fitted_order | if type == \"number\" then (. * 100 | round / 100) else \"-\" end))\"' %s", scene, i, file))
+family_of(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].family' %s", scene, i, file))
 # Line style of method i: 10 + its fixed style (plots/style.gp).
-sty(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
+sty_of(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
 N = int(system(sprintf("jq '.scenes.%s.methods | length' %s", scene, file)))
+# Each method's label, family and style read once (a jq call each), not per use.
+array LABEL[N]
+array FAMILY[N]
+array STY[N]
+do for [j=1:N] { LABEL[j] = label_of(j - 1); FAMILY[j] = family_of(j - 1); STY[j] = sty_of(j - 1) }
+label(i) = LABEL[i + 1]
+family(i) = FAMILY[i + 1]
+sty(i) = STY[i + 1]
 set logscale xy
 set format y "10^{%L}"
 set xlabel "h"

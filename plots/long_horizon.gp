@@ -6,11 +6,19 @@ set key noenhanced  # method labels contain underscores
 set terminal pngcairo size 1500,800 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 series(i, key, group) = sprintf("< jq -r '.scenes.%s.methods[%d] | select(.group == \"%s\") | [.t, .%s] | transpose[] | select(.[1] > 0) | @tsv' %s", scene, i, group, key, file)
-label(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label): \\(.fate)\"' %s", scene, i, file))
-group(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].group' %s", scene, i, file))
+label_of(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label): \\(.fate)\"' %s", scene, i, file))
+group_of(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].group' %s", scene, i, file))
 # Line style of method i: 10 + its fixed style (plots/style.gp).
-sty(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
+sty_of(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
 N = int(system(sprintf("jq '.scenes.%s.methods | length' %s", scene, file)))
+# Each method's label, group and style read once (a jq call each), not once per panel.
+array LABEL[N]
+array GROUP[N]
+array STY[N]
+do for [j=1:N] { LABEL[j] = label_of(j - 1); GROUP[j] = group_of(j - 1); STY[j] = sty_of(j - 1) }
+label(i) = LABEL[i + 1]
+group(i) = GROUP[i + 1]
+sty(i) = STY[i + 1]
 H = system(sprintf("jq -r '.scenes.%s.h' %s", scene, file))
 T = real(system(sprintf("jq -r '.scenes.%s.T' %s", scene, file)))
 # Systems with first integrals besides E (the contact oscillators: H_y, R) get a fourth panel.

@@ -6,9 +6,15 @@ set key noenhanced  # method labels contain underscores
 set terminal pngcairo size 1500,560 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 # Line style of method i: 10 + its fixed style (plots/style.gp).
-sty(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
+sty_of(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
 N = int(system(sprintf("jq '.scenes.%s.methods | length' %s", scene, file)))
-label(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].label' %s", scene, i, file))
+label_of(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].label' %s", scene, i, file))
+# Each method's label and style read once (a jq call each), not per use.
+array LABEL[N]
+array STY[N]
+do for [j=1:N] { LABEL[j] = label_of(j - 1); STY[j] = sty_of(j - 1) }
+label(i) = LABEL[i + 1]
+sty(i) = STY[i + 1]
 # h, max |E - E0| for runs of method i with the given status filter
 runs(i, filter) = sprintf("< jq -r '.scenes.%s.methods[%d].runs[] | select(%s) | [.h, .max_abs_energy_error] | @tsv' %s", scene, i, filter, file)
 set datafile separator "\t"

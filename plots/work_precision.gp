@@ -9,8 +9,14 @@ set datafile separator "\t"
 # The methods of this scene in their fixed order (style), from the JSON.
 methods = sprintf("jq -r '[.scenes.%s.runs[] | {label: .label, style: .style}] | unique_by(.style) | .[]' %s", scene, file)
 N = int(system(methods . " | jq -s length"))
-lab(i) = system(methods . sprintf(" | jq -s -r '.[%d].label'", i - 1))
-sty(i) = 10 + int(system(methods . sprintf(" | jq -s -r '.[%d].style'", i - 1)))
+lab_of(i) = system(methods . sprintf(" | jq -s -r '.[%d].label'", i - 1))
+sty_of(i) = 10 + int(system(methods . sprintf(" | jq -s -r '.[%d].style'", i - 1)))
+# Each method's label and style read once (two jq calls each), not per use.
+array LAB[N]
+array STY[N]
+do for [j=1:N] { LAB[j] = lab_of(j); STY[j] = sty_of(j) }
+lab(i) = LAB[i]
+sty(i) = STY[i]
 pts(i, err, cpu) = sprintf("< jq -r '.scenes.%s.runs[] | select(.label == \"%s\" and .status == \"ok\") | [.%s, .%s] | @tsv' %s", scene, lab(i), cpu, err, file)
 set logscale xy
 set format x "10^{%L}"
