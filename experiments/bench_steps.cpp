@@ -13,6 +13,7 @@
 #include <map>
 
 #include "cluster.hpp"
+#include "hand_steps.hpp"
 #include "nhi/methods.hpp"
 #include "nhi/output.hpp"
 #include "nhi/scene.hpp"
@@ -160,6 +161,28 @@ void BM_AnalyticFloor(benchmark::State& state) {
   }
 }
 
+// The floor for mp06 on contact_oscillator_nr: the step reduced by hand to one
+// scalar Newton iteration (experiments/hand_steps.hpp; the same map as the
+// library's to round-off, tests/test_new_methods.cpp), on the same trajectory
+// as BM_Method's rows: from the default state, restarted every 10^3 steps.
+void BM_Mp06NrFloor(benchmark::State& state) {
+  const nhi::ContactOscillatorNR sys;
+  floors::Mp06ContactOscillatorNR hand{sys.epsilon};
+  const Eigen::Vector3d q0 = sys.default_q0(), p0 = nhi::momentum(sys, q0, sys.default_v0());
+  Eigen::Vector3d q = q0, p = p0, q1, p1;
+  double lambda = 0;
+  long k = 0;
+  for (auto _ : state) {
+    hand.step(kH, q, p, &q1, &p1, &lambda);
+    q = q1;
+    p = p1;
+    benchmark::DoNotOptimize(q);
+    benchmark::DoNotOptimize(p);
+    if (++k % 1000 == 0) q = q0, p = p0, lambda = 0;
+  }
+  state.counters["newton_iterations_per_step"] = double(hand.iterations) / double(state.iterations());
+}
+
 class Capture : public benchmark::ConsoleReporter {
  public:
   nhi::json rows = nhi::json::array();
@@ -178,9 +201,11 @@ class Capture : public benchmark::ConsoleReporter {
 }  // namespace
 
 // One row per registered scene and fixed-step study method, plus the
-// reference solution per run, plus the particle's floor comparison.
+// reference solution per run, plus the floor comparisons (the particle's
+// midpoint DLA, contact_oscillator_nr's mp06).
 void register_all() {
   benchmark::RegisterBenchmark("particle/analytic_newton_floor", BM_AnalyticFloor);
+  benchmark::RegisterBenchmark("contact_oscillator_nr/mp06_hand_reduced_floor", BM_Mp06NrFloor);
   benchmark::RegisterBenchmark("particle/dla_map_alpha0.5", [](benchmark::State& st) {
     BM_DlaMap<nhi::Particle, nhi::AlphaDiscretization>(st, nhi::AlphaDiscretization{0.5});
   });
@@ -266,6 +291,9 @@ int main(int argc, char** argv) {
   const double floor = ns("particle/analytic_newton_floor"), dla = ns("particle/dla_map_alpha0.5");
   result["particle_dla_over_floor"] = std::isfinite(floor) && std::isfinite(dla) ? nhi::json(dla / floor) : nhi::json(nullptr);
   result["target_ratio"] = 2.0;
+  const double nr_floor = ns("contact_oscillator_nr/mp06_hand_reduced_floor"), nr = ns("contact_oscillator_nr/mp06");
+  result["nr_mp06_over_floor"] =
+      std::isfinite(nr_floor) && std::isfinite(nr) ? nhi::json(nr / nr_floor) : nhi::json(nullptr);
   result["meta"] = nhi::meta();
   try {
     nhi::AtomicFile f(out);

@@ -65,11 +65,13 @@ jq -r "$G"'.benchmarks[] | "| \(.name) | \(.cpu_ns | round) | \(if .ratio_to_rk4
 echo
 jq -r "$G"'"Particle DLA step / analytic Newton floor: \(.particle_dla_over_floor | g) (target <= \(.target_ratio))"' "$R/step_costs.json"
 echo
+jq -r "$G"'if .nr_mp06_over_floor then "contact_oscillator_nr mp06 step / hand-reduced floor (the step by hand as one scalar equation, experiments/hand_steps.hpp): \(.nr_mp06_over_floor | g)" else empty end' "$R/step_costs.json"
+echo
 echo "The same run as one row per method: ns per step / ratio to that scene's RK4 step / Newton"
 echo "iterations per step (implicit methods; a composition counts every stage's)."
 echo
 jq -r "$G"'
-  [.benchmarks[] | select(.name | test("/") and (test("reference_run|analytic|dla_map") | not))
+  [.benchmarks[] | select(.name | test("/") and (test("reference_run|analytic|dla_map|floor") | not))
    | {scene: (.name | split("/")[0]), method: (.name | split("/")[1]), ns: .cpu_ns, r: .ratio_to_rk4,
       it: .counters.newton_iterations_per_step}] as $rows |
   ($rows | map(.scene) | unique) as $scenes |

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 
+#include "../experiments/hand_steps.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {
@@ -341,6 +342,40 @@ TEST(Mp06, ParticleStepIsTheClosedForm) {
     EXPECT_LE((z.tail<3>() - p1).cwiseAbs().maxCoeff(), 64 * kEps * (1 + p1.cwiseAbs().maxCoeff())) << h;
     EXPECT_NEAR(st.lambda()[0], lambda, 1e-12 * (1 + std::abs(lambda))) << h;
     EXPECT_LE(std::abs(-q1[1] * p1[0] + p1[2]), 16 * kEps * (1 + p1.cwiseAbs().maxCoeff()));  // held at q1
+  }
+}
+
+// bench_steps' floor for mp06 on contact_oscillator_nr (experiments/hand_steps.hpp:
+// the step reduced by hand to one scalar equation) is the library's mp06 map:
+// from random parameters and states, single steps at several h, and 2000
+// chained steps at the benchmark's h = 0.2, agree to round-off.
+TEST(Mp06, ContactOscillatorNRHandReducedStepIsTheLibraryStep) {
+  using S = ContactOscillatorNR;
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 4; ++trial) {
+    const S sys = randomized_system<S>(rng);
+    Vec<double, 3> q0, v0;
+    random_state<S>(rng, &q0, &v0, sys);
+    const Mp06Stepper<S> lib(sys);
+    floors::Mp06ContactOscillatorNR hand{sys.epsilon};
+    for (double h : {0.2, -0.13, 0.01}) {
+      Vec<double, 3> q = q0, p = momentum(sys, q0, v0), qa, pa, qb, pb;
+      Vec<double, 1> lb = Vec<double, 1>::Zero();
+      double la = 0, dq = 0, dp = 0, dhl = 0, size = 1;
+      const int steps = h == 0.2 ? 2000 : 1;
+      for (int k = 0; k < steps; ++k) {
+        hand.step(h, q, p, &qa, &pa, &la);
+        ASSERT_TRUE(lib.map(h, q, p, &qb, &pb, &lb).ok());
+        dq = std::max(dq, (qa - qb).cwiseAbs().maxCoeff());
+        dp = std::max(dp, (pa - pb).cwiseAbs().maxCoeff());
+        dhl = std::max(dhl, std::abs(h * (la - lb[0])));
+        size = std::max({size, qb.cwiseAbs().maxCoeff(), pb.cwiseAbs().maxCoeff()});
+        q = qb, p = pb, la = lb[0];  // both continue from the library's state
+      }
+      EXPECT_LE(dq, 64 * kEps * size) << "trial " << trial << " h " << h;
+      EXPECT_LE(dp, 64 * kEps * size) << "trial " << trial << " h " << h;
+      EXPECT_LE(dhl, 64 * kEps * size) << "trial " << trial << " h " << h;
+    }
   }
 }
 
