@@ -61,7 +61,7 @@ echo "## Step costs (results/step_costs.json), CPU ns per step (CVODE: ms per ru
 echo
 echo "| benchmark | CPU | / RK4 (same scene, same run) | Newton iterations per step |"
 echo "|---|---|---|---|"
-jq -r "$G"'.benchmarks[] | "| \(.name) | \(.cpu_ns | round) | \(if .ratio_to_rk4 then (.ratio_to_rk4 * 100 | round / 100 | tostring) else "-" end) | \(if .counters.newton_iterations_per_step then (.counters.newton_iterations_per_step * 100 | round / 100 | tostring) else "-" end) |"' "$R/step_costs.json"
+jq -r "$G"'.benchmarks | sort_by(.name)[] | "| \(.name) | \(.cpu_ns | round) | \(if .ratio_to_rk4 then (.ratio_to_rk4 * 100 | round / 100 | tostring) else "-" end) | \(if .counters.newton_iterations_per_step then (.counters.newton_iterations_per_step * 100 | round / 100 | tostring) else "-" end) |"' "$R/step_costs.json"
 echo
 jq -r "$G"'"Particle DLA step / analytic Newton floor: \(.particle_dla_over_floor | g) (target <= \(.target_ratio))"' "$R/step_costs.json"
 echo
@@ -75,7 +75,7 @@ jq -r "$G"'
    | {scene: (.name | split("/")[0]), method: (.name | split("/")[1]), ns: .cpu_ns, r: .ratio_to_rk4,
       it: .counters.newton_iterations_per_step}] as $rows |
   ($rows | map(.scene) | unique) as $scenes |
-  ($rows | map(.method) | reduce .[] as $m ([]; if index([$m]) then . else . + [$m] end)) as $methods |
+  ($rows | map(.method) | unique) as $methods |
   "| method | " + ($scenes | join(" | ")) + " |",
   "|---|" + ($scenes | map("---|") | join("")),
   ($methods[] as $m | "| \($m) | " + ([$scenes[] as $s | ($rows[] | select(.scene == $s and .method == $m)) //
