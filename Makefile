@@ -136,8 +136,9 @@ $(2): results/$(1).json
 # figure is byte-identical (issue 13: plotting from the whole files took
 # ~330 CPU s of make reproduce, shared with the studies' cores).
 plots/$(1)_%.png: plots/$(1).gp plots/style.gp results/$(1).json
-	slice=$$$$(mktemp) && jq -c --arg s '$$*' '. + {scenes: {($$$$s): .scenes[$$$$s]}}' results/$(1).json > $$$$slice && \
-	  { gnuplot -e "file='$$$$slice'; scene='$$*'; out='$$@'" $$< 2>&1 | { grep -v Skipping || true; }; }; rm -f $$$$slice
+	slice=$$$$(mktemp) && { jq -c --arg s '$$*' '. + {scenes: {($$$$s): .scenes[$$$$s]}}' results/$(1).json > $$$$slice && \
+	  { gnuplot -e "file='$$$$slice'; scene='$$*'; out='$$@'" $$< 2>&1 | { grep -v Skipping || true; }; }; \
+	  rc=$$$$?; rm -f $$$$slice; exit $$$$rc; }
 endef
 $(eval $(call STUDY,convergence,study-convergence))
 $(eval $(call STUDY,long_horizon,study-long-horizon))
