@@ -134,11 +134,13 @@ $(2): results/$(1).json
 # The script reads the scene's slice of the result (the other scenes dropped
 # by one jq pass): its many jq calls then parse a sixth of the file, and the
 # figure is byte-identical (issue 13: plotting from the whole files took
-# ~330 CPU s of make reproduce, shared with the studies' cores).
+# ~330 CPU s of make reproduce, shared with the studies' cores).  A failure of
+# jq or gnuplot fails the target; gnuplot's "Skipping data file" warnings
+# (series empty for a scene) are dropped.
 plots/$(1)_%.png: plots/$(1).gp plots/style.gp results/$(1).json
-	slice=$$$$(mktemp) && { jq -c --arg s '$$*' '. + {scenes: {($$$$s): .scenes[$$$$s]}}' results/$(1).json > $$$$slice && \
-	  { gnuplot -e "file='$$$$slice'; scene='$$*'; out='$$@'" $$< 2>&1 | { grep -v Skipping || true; }; }; \
-	  rc=$$$$?; rm -f $$$$slice; exit $$$$rc; }
+	slice=$$$$(mktemp) && log=$$$$(mktemp) && { jq -c --arg s '$$*' '. + {scenes: {($$$$s): .scenes[$$$$s]}}' results/$(1).json > $$$$slice && \
+	  gnuplot -e "file='$$$$slice'; scene='$$*'; out='$$@'" $$< > $$$$log 2>&1; \
+	  rc=$$$$?; grep -v Skipping $$$$log; rm -f $$$$slice $$$$log; exit $$$$rc; }
 endef
 $(eval $(call STUDY,convergence,study-convergence))
 $(eval $(call STUDY,long_horizon,study-long-horizon))
