@@ -25,9 +25,7 @@ namespace floors {
 // equation in w:
 //   g(w) = (w + sin(z_half + h w / 2)) (1 - (h/2) cos z_half) - bz + y_half (y1 w + bx) = 0,
 // solved by Newton with g' written out: one sin and one cos per iteration.
-// The start is the zero of g linearized at w = 0 (no new sin or cos; starting
-// instead from the momentum equation with the last multiplier took 2.99
-// iterations a step on bench_steps' trajectory, this start 2.3).  The iteration
+// The start is the momentum equation with the last multiplier.  The iteration
 // stops when the Newton update is below 1e-9 relative, after which the error is
 // of the order of its square (no residual is evaluated to confirm it, which the
 // library's solve does): a floor, not a robust solver.
@@ -35,7 +33,6 @@ struct Mp06ContactOscillatorNR {
   double epsilon = 0.3;
   long iterations = 0;  // summed over steps
 
-  // *lambda: the step's multiplier on return (not read: the start does not need it).
   void step(double h, const Eigen::Vector3d& q0, const Eigen::Vector3d& p0, Eigen::Vector3d* q1,
             Eigen::Vector3d* p1, double* lambda) {
     const double xh = q0[0] + 0.5 * h * p0[0], yh = q0[1] + 0.5 * h * p0[1];
@@ -47,9 +44,7 @@ struct Mp06ContactOscillatorNR {
     const double a = 1 - 0.5 * h * ch;
     const double bx = p0[0] - h * Ux;
     const double bz = p0[2] - h * Uz + 0.5 * h * ch * (p0[2] - 2 * sh);
-    // Start: g linearized at w = 0 (sin z1 ~ sin z_half + cos z_half (h/2) w),
-    // with the sin and cos already at hand.
-    double w = (bz - yh * bx - a * sh) / (a * (1 + 0.5 * h * ch) + yh * y1);
+    double w = (bz + h * yh * *lambda) / a - sh;
     double z1 = zh, s1 = sh;
     for (int it = 0; it < 20; ++it) {
       z1 = zh + 0.5 * h * w;
