@@ -2,7 +2,10 @@
 // fixed-step study method on each registered scene (the stepper as the
 // integrate loop drives it), the reference solution per run, and for the
 // particle a hand-derived Newton step with the analytic Jacobian (the floor the
-// library's DLA map is measured against, as a ratio in the same run).  Writes results/step_costs.json:  bench_steps -o FILE [google
+// library's DLA map is measured against, as a ratio in the same run), and for
+// contact_oscillator_nr mp06 reduced by hand to one scalar equation
+// (experiments/hand_steps.hpp, the floor of the library's mp06 step there).
+// Writes results/step_costs.json:  bench_steps -o FILE [google
 // benchmark flags].  Steps cycle through states of a real trajectory.
 #include <benchmark/benchmark.h>
 
@@ -162,7 +165,7 @@ void BM_AnalyticFloor(benchmark::State& state) {
 }
 
 // The floor for mp06 on contact_oscillator_nr: the step reduced by hand to one
-// scalar Newton iteration (experiments/hand_steps.hpp; the same map as the
+// scalar equation solved by Newton (experiments/hand_steps.hpp; the same map as the
 // library's to round-off, tests/test_new_methods.cpp), on the same trajectory
 // as BM_Method's rows: from the default state, restarted every 10^3 steps.
 void BM_Mp06NrFloor(benchmark::State& state) {
