@@ -5,15 +5,19 @@
 // library's DLA map is measured against, as a ratio in the same run), and for
 // contact_oscillator_nr mp06 reduced by hand to one scalar equation
 // (experiments/hand_steps.hpp, the floor of the library's mp06 step there).
-// Writes results/step_costs.json:  bench_steps -o FILE [google
-// benchmark flags].  Steps cycle through states of a real trajectory.
+// Writes results/step_costs.json:  bench_steps -o FILE [--shard K/N] [google
+// benchmark flags];  bench_steps --merge SHARD.json... -o FILE joins shards.
+// Steps cycle through states of a real trajectory.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <fstream>
 #include <map>
+#include <set>
+#include <sstream>
 
 #include "cluster.hpp"
 #include "hand_steps.hpp"
@@ -176,7 +180,10 @@ void BM_Mp06NrFloor(benchmark::State& state) {
   double lambda = 0;
   long k = 0;
   for (auto _ : state) {
-    hand.step(kH, q, p, &q1, &p1, &lambda);
+    if (!hand.step(kH, q, p, &q1, &p1, &lambda)) {
+      state.SkipWithError("the hand-reduced step did not converge in 20 Newton iterations");
+      break;
+    }
     q = q1;
     p = p1;
     benchmark::DoNotOptimize(q);
@@ -189,9 +196,14 @@ void BM_Mp06NrFloor(benchmark::State& state) {
 class Capture : public benchmark::ConsoleReporter {
  public:
   nhi::json rows = nhi::json::array();
+  std::vector<std::string> errors;  // rows that stopped with SkipWithError
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const auto& r : runs) {
       if (r.run_type != Run::RT_Iteration) continue;
+      if (r.error_occurred) {
+        errors.push_back(r.benchmark_name() + ": " + r.error_message);
+        continue;
+      }
       nhi::json row = {{"name", r.benchmark_name()}, {"iterations", r.iterations},
                        {"real_ns", r.GetAdjustedRealTime()}, {"cpu_ns", r.GetAdjustedCPUTime()}};
       for (const auto& [k, c] : r.counters) row["counters"][k] = double(c);
@@ -205,92 +217,51 @@ class Capture : public benchmark::ConsoleReporter {
 
 // One row per registered scene and fixed-step study method, plus the
 // reference solution per run, plus the floor comparisons (the particle's
-// midpoint DLA, contact_oscillator_nr's mp06).
-void register_all() {
-  benchmark::RegisterBenchmark("particle/analytic_newton_floor", BM_AnalyticFloor);
-  benchmark::RegisterBenchmark("contact_oscillator_nr/mp06_hand_reduced_floor", BM_Mp06NrFloor);
-  benchmark::RegisterBenchmark("particle/dla_map_alpha0.5", [](benchmark::State& st) {
-    BM_DlaMap<nhi::Particle, nhi::AlphaDiscretization>(st, nhi::AlphaDiscretization{0.5});
-  });
-  nhi::for_each_type(nhi::Systems{}, [](auto tag) {
+// midpoint DLA, contact_oscillator_nr's mp06), each with its scene.  With
+// nshards > 1 only the scenes whose place in nhi::Systems is shard modulo
+// nshards: make reproduce runs two shards at once, one per core (see main).
+void register_all(int shard, int nshards) {
+  int index = 0;
+  nhi::for_each_type(nhi::Systems{}, [&](auto tag) {
     using S = typename decltype(tag)::type;
+    if (index++ % nshards != shard) return;
+    const std::string scene = S::name;
+    if (scene == "particle") {
+      benchmark::RegisterBenchmark("particle/analytic_newton_floor", BM_AnalyticFloor);
+      benchmark::RegisterBenchmark("particle/dla_map_alpha0.5", [](benchmark::State& st) {
+        BM_DlaMap<nhi::Particle, nhi::AlphaDiscretization>(st, nhi::AlphaDiscretization{0.5});
+      });
+    }
+    if (scene == "contact_oscillator_nr")
+      benchmark::RegisterBenchmark("contact_oscillator_nr/mp06_hand_reduced_floor", BM_Mp06NrFloor);
     for (const nhi::StudyMethod& m : nhi::study_methods()) {
       if (m.external || m.spec.kind == "benchmark") continue;  // every fixed-step method, variants too
-      std::string name = std::string(S::name) + "/" + m.label();
+      std::string name = scene + "/" + m.label();
       std::replace(name.begin(), name.end(), ' ', '_');
       const nhi::MethodSpec spec = m.spec;
       benchmark::RegisterBenchmark(name.c_str(), [spec](benchmark::State& st) { BM_Method<S>(st, spec); });
     }
-    benchmark::RegisterBenchmark((std::string(S::name) + "/reference_run_T200").c_str(), BM_Reference<S>)
+    benchmark::RegisterBenchmark((scene + "/reference_run_T200").c_str(), BM_Reference<S>)
         ->Unit(benchmark::kMillisecond);
   });
 }
 
-int main(int argc, char** argv) {
-  // Timed: copies on one node would share its cores, and it is not sharded
-  // (README, "Running on a cluster").
-  if (study::launcher_ranks() > 1) {
-    std::cerr << "bench_steps: started as one of " << study::launcher_ranks()
-              << " ranks; it is timed and not sharded: run it as one process\n";
-    return 2;
-  }
-  std::string out;
-  std::vector<char*> args;
-  for (int i = 0; i < argc; ++i) {
-    if (std::strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
-      out = argv[++i];
-    } else {
-      args.push_back(argv[i]);
-    }
-  }
-  int n = static_cast<int>(args.size());
-  register_all();
-  benchmark::Initialize(&n, args.data());
-  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 2;
-  Capture rep;
-  benchmark::RunSpecifiedBenchmarks(&rep);
-  if (out.empty()) return 0;
-  // With --benchmark_repetitions=N (make reproduce: 3, randomly interleaved,
-  // so that a slow spell of the machine falls on one repetition of a row, not
-  // on all of it), each row is the repetition with the least CPU time (the
-  // machine's noise only adds: in one run the robot's RK4 step read 117, 200
-  // and 201 ns), and cpu_ns_repetitions lists all of them.
-  {
-    std::vector<std::string> order;
-    std::map<std::string, std::vector<nhi::json>> by_name;
-    for (const auto& r : rep.rows) {
-      const std::string name = r["name"];
-      if (!by_name.count(name)) order.push_back(name);
-      by_name[name].push_back(r);
-    }
-    nhi::json rows = nhi::json::array();
-    for (const std::string& name : order) {
-      std::vector<nhi::json>& rs = by_name[name];
-      std::sort(rs.begin(), rs.end(), [](const nhi::json& a, const nhi::json& b) {
-        return a["cpu_ns"].get<double>() < b["cpu_ns"].get<double>();
-      });
-      nhi::json row = rs.front();
-      row["repetitions"] = rs.size();
-      row["cpu_ns_repetitions"] = nhi::json::array();
-      for (const auto& r : rs) row["cpu_ns_repetitions"].push_back(r["cpu_ns"]);
-      rows.push_back(row);
-    }
-    rep.rows = rows;
-  }
+// The result from its rows: each scene's steps as a ratio to that scene's RK4
+// step (the same process, so the same run), and the floor ratios.
+nhi::json step_costs(const nhi::json& rows) {
   auto ns = [&](const std::string& name) {
-    for (const auto& r : rep.rows)
+    for (const auto& r : rows)
       if (r["name"] == name) return r["cpu_ns"].get<double>();
     return std::nan("");
   };
-  // Each scene's steps as a ratio to that scene's RK4 step in this run.
-  for (auto& r : rep.rows) {
+  nhi::json result = {{"study", "step_costs"}, {"benchmarks", rows}};
+  for (auto& r : result["benchmarks"]) {
     const std::string name = r["name"];
     const std::string scene = name.substr(0, name.find('/'));
     const double rk4 = ns(scene + "/rk4");
     if (name.find("reference_run") == std::string::npos && std::isfinite(rk4))
       r["ratio_to_rk4"] = r["cpu_ns"].get<double>() / rk4;
   }
-  nhi::json result = {{"study", "step_costs"}, {"benchmarks", rep.rows}};
   const double floor = ns("particle/analytic_newton_floor"), dla = ns("particle/dla_map_alpha0.5");
   result["particle_dla_over_floor"] = std::isfinite(floor) && std::isfinite(dla) ? nhi::json(dla / floor) : nhi::json(nullptr);
   result["target_ratio"] = 2.0;
@@ -298,6 +269,10 @@ int main(int argc, char** argv) {
   result["nr_mp06_over_floor"] =
       std::isfinite(nr_floor) && std::isfinite(nr) ? nhi::json(nr / nr_floor) : nhi::json(nullptr);
   result["meta"] = nhi::meta();
+  return result;
+}
+
+int write(const std::string& out, const nhi::json& result) {
   try {
     nhi::AtomicFile f(out);
     f.commit(result.dump(2) + "\n");
@@ -306,4 +281,111 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+// bench_steps --merge A.json B.json ... -o OUT: the shards' rows in one result
+// (each shard holds whole scenes, so every ratio stays within one process).
+int merge(const std::vector<std::string>& files, const std::string& out) {
+  nhi::json rows = nhi::json::array();
+  std::set<std::string> names;
+  for (const std::string& file : files) {
+    std::ifstream in(file);
+    nhi::json part;
+    try {
+      part = nhi::json::parse(in);
+    } catch (const std::exception& e) {
+      std::cerr << "bench_steps --merge: " << file << ": " << e.what() << "\n";
+      return 1;
+    }
+    if (!part.is_object() || part.value("study", "") != "step_costs" || !part["benchmarks"].is_array()) {
+      std::cerr << "bench_steps --merge: " << file << " is not a bench_steps result\n";
+      return 1;
+    }
+    for (const auto& r : part["benchmarks"]) {
+      if (!names.insert(r.at("name").get<std::string>()).second) {
+        std::cerr << "bench_steps --merge: row " << r["name"] << " is in more than one shard\n";
+        return 1;
+      }
+      rows.push_back(r);
+    }
+  }
+  return write(out, step_costs(rows));
+}
+
+int main(int argc, char** argv) {
+  // Timed: copies on one node would share its cores, and it is not sharded
+  // by the cluster launcher (README, "Running on a cluster").
+  if (study::launcher_ranks() > 1) {
+    std::cerr << "bench_steps: started as one of " << study::launcher_ranks()
+              << " ranks; it is timed and not sharded: run it as one process\n";
+    return 2;
+  }
+  std::string out;
+  std::vector<std::string> merge_files;
+  int shard = 0, nshards = 1;
+  bool merging = false;
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    if (std::strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
+      out = argv[++i];
+    } else if (std::strcmp(argv[i], "--shard") == 0 && i + 1 < argc) {
+      // --shard K/N: the scenes K, K + N, ... of nhi::Systems.
+      char slash = 0;
+      std::istringstream in(argv[++i]);
+      if (!(in >> shard >> slash >> nshards) || slash != '/' || !in.eof() || nshards < 1 || shard < 0 ||
+          shard >= nshards) {
+        std::cerr << "bench_steps: --shard wants K/N with 0 <= K < N, got '" << argv[i] << "'\n";
+        return 2;
+      }
+    } else if (std::strcmp(argv[i], "--merge") == 0) {
+      merging = true;
+    } else if (merging && argv[i][0] != '-') {
+      merge_files.push_back(argv[i]);
+    } else {
+      args.push_back(argv[i]);
+    }
+  }
+  if (merging) {
+    if (out.empty() || merge_files.empty() || args.size() > 1) {
+      std::cerr << "bench_steps: --merge FILE... -o OUT (and nothing else)\n";
+      return 2;
+    }
+    return merge(merge_files, out);
+  }
+  int n = static_cast<int>(args.size());
+  register_all(shard, nshards);
+  benchmark::Initialize(&n, args.data());
+  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 2;
+  Capture rep;
+  benchmark::RunSpecifiedBenchmarks(&rep);
+  if (!rep.errors.empty()) {  // no result with a row missing or wrong
+    for (const auto& e : rep.errors) std::cerr << "bench_steps: " << e << "\n";
+    return 1;
+  }
+  if (out.empty()) return 0;
+  // With --benchmark_repetitions=N (make reproduce: 3, randomly interleaved,
+  // so that a slow spell of the machine falls on one repetition of a row, not
+  // on all of it), each row is the repetition with the least CPU time (the
+  // machine's noise only adds: in one run the robot's RK4 step read 117, 200
+  // and 201 ns), and cpu_ns_repetitions lists all of them.
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<nhi::json>> by_name;
+  for (const auto& r : rep.rows) {
+    const std::string name = r["name"];
+    if (!by_name.count(name)) order.push_back(name);
+    by_name[name].push_back(r);
+  }
+  nhi::json rows = nhi::json::array();
+  for (const std::string& name : order) {
+    std::vector<nhi::json>& rs = by_name[name];
+    std::sort(rs.begin(), rs.end(), [](const nhi::json& a, const nhi::json& b) {
+      return a["cpu_ns"].get<double>() < b["cpu_ns"].get<double>();
+    });
+    nhi::json row = rs.front();
+    row["repetitions"] = rs.size();
+    row["cpu_ns_repetitions"] = nhi::json::array();
+    for (const auto& r : rs) row["cpu_ns_repetitions"].push_back(r["cpu_ns"]);
+    rows.push_back(row);
+  }
+  return write(out, step_costs(rows));
 }

@@ -364,7 +364,7 @@ TEST(Mp06, ContactOscillatorNRHandReducedStepIsTheLibraryStep) {
       double la = 0, dq = 0, dp = 0, dhl = 0, size = 1;
       const int steps = h == 0.2 ? 2000 : 1;
       for (int k = 0; k < steps; ++k) {
-        hand.step(h, q, p, &qa, &pa, &la);
+        ASSERT_TRUE(hand.step(h, q, p, &qa, &pa, &la));
         ASSERT_TRUE(lib.map(h, q, p, &qb, &pb, &lb).ok());
         dq = std::max(dq, (qa - qb).cwiseAbs().maxCoeff());
         dp = std::max(dp, (pa - pb).cwiseAbs().maxCoeff());
