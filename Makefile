@@ -131,16 +131,13 @@ define STUDY
 .PHONY: $(2)
 $(2): results/$(1).json
 	$$(MAKE) --no-print-directory $$$$(jq -r '.scenes | keys_unsorted[] | "plots/$(1)_" + . + ".png"' $$<)
-# The script reads the scene's slice of the result (the other scenes dropped
-# by one jq pass): its many jq calls then parse a sixth of the file, and the
-# figure is byte-identical (issue 13: plotting from the whole files took
-# ~330 CPU s of make reproduce, shared with the studies' cores).  A failure of
-# jq or gnuplot fails the target; gnuplot's "Skipping data file" warnings
-# (series empty for a scene) are dropped.
+# The script reads everything it needs from the result in one jq pass
+# (jq_script, plots/style.gp; until issue 13 one jq call per label and series,
+# ~100 CPU s of make reproduce).  A failure of jq or gnuplot fails the target;
+# gnuplot's "Skipping data file" warnings (a series empty for a scene) are dropped.
 plots/$(1)_%.png: plots/$(1).gp plots/style.gp results/$(1).json
-	slice=$$$$(mktemp) && log=$$$$(mktemp) && { jq -c --arg s '$$*' '. + {scenes: {($$$$s): .scenes[$$$$s]}}' results/$(1).json > $$$$slice && \
-	  gnuplot -e "file='$$$$slice'; scene='$$*'; out='$$@'" $$< > $$$$log 2>&1; \
-	  rc=$$$$?; grep -v Skipping $$$$log; rm -f $$$$slice $$$$log; exit $$$$rc; }
+	log=$$$$(mktemp) && { gnuplot -e "file='results/$(1).json'; scene='$$*'; out='$$@'" $$< > $$$$log 2>&1; \
+	  rc=$$$$?; grep -v Skipping $$$$log; rm -f $$$$log; exit $$$$rc; }
 endef
 $(eval $(call STUDY,convergence,study-convergence))
 $(eval $(call STUDY,long_horizon,study-long-horizon))
@@ -155,7 +152,8 @@ results/convergence.json results/long_horizon.json results/stability.json result
 .PHONY: study-geometry
 study-geometry: $(GEOMETRY_FIGURES)
 plots/geometry_%.png: plots/geometry_%.gp plots/style.gp results/geometry.json
-	gnuplot -e "file='results/geometry.json'; out='$@'" $< 2>&1 | { grep -v Skipping || true; }
+	log=$$(mktemp) && { gnuplot -e "file='results/geometry.json'; out='$@'" $< > $$log 2>&1; \
+	  rc=$$?; grep -v Skipping $$log; rm -f $$log; exit $$rc; }
 
 # Timed studies run after the others and their figures (order-only
 # prerequisites), so that no other job shares the two cores while they

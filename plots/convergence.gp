@@ -1,25 +1,29 @@
 # Study 1: global error at T against h, log-log, with reference slopes.
 # Called as gnuplot -e "file='results/convergence.json'; scene='particle'; out='plots/convergence_particle.png'" plots/convergence.gp
 load "plots/style.gp"
-set key noenhanced  # method labels contain underscores
-set terminal pngcairo size 1400,620 enhanced font "DejaVu Sans,10" linewidth 1.2
-set output out
-# Columns h, error of method i if its family is (want = 1) or is not (want = 0) "isolation".
-m(i, want) = sprintf("< jq -r '.scenes.%s.methods[%d] | select((.family == \"isolation\") == %s) | [.h, .error] | transpose[] | select(.[1] != null) | @tsv' %s", scene, i, want ? "true" : "false", file)
-# (fitted_order is null where no two errors above round-off remain: "p = -")
-label_of(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label) (p = \\(.fitted_order | if type == \"number\" then (. * 100 | round / 100) else \"-\" end))\"' %s", scene, i, file))
-family_of(i) = system(sprintf("jq -r '.scenes.%s.methods[%d].family' %s", scene, i, file))
-# Line style of method i: 10 + its fixed style (plots/style.gp).
-sty_of(i) = 10 + int(system(sprintf("jq -r '.scenes.%s.methods[%d].style // 12' %s", scene, i, file)))
-N = int(system(sprintf("jq '.scenes.%s.methods | length' %s", scene, file)))
-# Each method's label, family and style read once (a jq call each), not per use.
-array LABEL[N]
-array FAMILY[N]
-array STY[N]
-do for [j=1:N] { LABEL[j] = label_of(j - 1); FAMILY[j] = family_of(j - 1); STY[j] = sty_of(j - 1) }
+# Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
+#   N; LABEL, FAMILY, STY[i + 1] of method i (label with its fitted order, family,
+#   10 + style; fitted_order is null where no two errors above round-off
+#   remain: "p = -");
+#   $M<i>_0, $M<i>_1: h and error of method i if its family is not (0) or is (1)
+#   "isolation", rows without an error dropped.
+load jq_script(sprintf("--arg scene '%s'", scene), \
+  '.scenes[$scene].methods | "N = \(length)", "array LABEL[N]", "array FAMILY[N]", "array STY[N]", ' . \
+  '(to_entries[] | .key as $i | .value ' . \
+  ' | "LABEL[\($i + 1)] = \("\(.label) (p = \(.fitted_order | if type == "number" then (. * 100 | round / 100) else "-" end))" | gp)", ' . \
+  '   "FAMILY[\($i + 1)] = \(.family | gp)", "STY[\($i + 1)] = 10 + int(\(.style // 12 | gp))", ' . \
+  '   ((0, 1) as $want | jq_block("$M\($i)_\($want)"; ' . \
+  '      select((.family == "isolation") == ($want == 1)) | [.h, .error] | transpose[] | select(.[1] != null)))), ' . \
+  '"jq_ok = 1"', file)
+if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s, no figure drawn", out, file) }
 label(i) = LABEL[i + 1]
 family(i) = FAMILY[i + 1]
 sty(i) = STY[i + 1]
+# Columns h, error of method i if its family is (want = 1) or is not (want = 0) "isolation".
+m(i, want) = sprintf("$M%d_%d", i, want)
+set key noenhanced  # method labels contain underscores
+set terminal pngcairo size 1400,620 enhanced font "DejaVu Sans,10" linewidth 1.2
+set output out
 set logscale xy
 set format y "10^{%L}"
 set xlabel "h"

@@ -4,10 +4,21 @@
 # Called as gnuplot -e "file='results/geometry.json'; out='plots/geometry_momentum.png'" plots/geometry_momentum.gp
 load "plots/style.gp"
 set terminal pngcairo size 1500,520 enhanced font "DejaVu Sans,10" linewidth 1.2
+# Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
+#   J0r, J_0 of the robot's run 0;
+#   $<sys>_<i>_J, $<sys>_<i>_J0_plus_sum_rhs: t and J, t and J_0 + sum of the
+#   rhs along run i of sys (particle, robot);
+#   $<sys>_<i>_res: t_k and the residual of step k, where it is > 0 (log scale).
+load jq_script("", \
+  '.momentum | "J0r = real(\(.robot.runs[0].J[0] | gp))", ' . \
+  '(to_entries[] | .key as $sys | .value.runs | to_entries[] | .key as $i | .value ' . \
+  ' | (("J", "J0_plus_sum_rhs") as $key | jq_block("$\($sys)_\($i)_\($key)"; [.t, .[$key]] | transpose[])), ' . \
+  '   jq_block("$\($sys)_\($i)_res"; [.t[:-1], .residual] | transpose[] | select(.[1] > 0))), ' . \
+  '"jq_ok = 1"', file)
+if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s, no figure drawn", out, file) }
+run(sys, i, key) = sprintf("$%s_%d_%s", sys, i, key)
+res(sys, i) = sprintf("$%s_%d_res", sys, i)
 set output out
-run(sys, i, key) = sprintf("< jq -r '.momentum.%s.runs[%d] | [.t, .%s] | transpose[] | @tsv' %s", sys, i, key, file)
-res(sys, i) = sprintf("< jq -r '.momentum.%s.runs[%d] | [.t[:-1], .residual] | transpose[] | select(.[1] > 0) | @tsv' %s", sys, i, file)
-J0r = real(system(sprintf("jq '.momentum.robot.runs[0].J[0]' %s", file)))
 set style data lines
 set xlabel "t"
 set multiplot layout 1,3 title "Discrete nonholonomic momentum equation (Theorem 5.3, eq. 24), DLA, h = 0.2"

@@ -2,12 +2,24 @@
 # one colour per initial state.
 # Called as gnuplot -e "file='results/poincare.json'; scene='contact_oscillator'; out='plots/poincare_contact_oscillator.png'" plots/poincare.gp
 load "plots/style.gp"
+# Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
+#   N methods, S initial states; TITLE[i + 1], the panel title of method i
+#   (label, median thickness ratio, max |R - R_0|);
+#   $P<i>_<j>: z, dz/dt of the section points of method i from initial state j,
+#   points with a missing coordinate dropped.
+load jq_script(sprintf("--arg scene '%s'", scene), \
+  '.scenes[$scene] as $s | ($s.initial_states | length) as $S ' . \
+  '| "N = \($s.methods | length)", "S = \($S)", "array TITLE[N]", ' . \
+  '($s.methods | to_entries[] | .key as $i | .value ' . \
+  ' | "TITLE[\($i + 1)] = \("\(.label): thickness x\(.summary.median_thickness_ratio // "-" | if type == "number" then (. * 100 | round / 100) else . end), max |R-R_0| \(.summary.max_abs_R_error | . * 1e4 | round / 1e4)" | gp)", ' . \
+  '   (range($S) as $j | jq_block("$P\($i)_\($j)"; ' . \
+  '      .runs[$j] | [.z, .zd] | transpose[] | select(.[0] != null and .[1] != null)))), ' . \
+  '"jq_ok = 1"', file)
+if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s, no figure drawn", out, file) }
+title(i) = TITLE[i + 1]
+pts(i, j) = sprintf("$P%d_%d", i, j)
 set terminal pngcairo size 1600,1500 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
-N = int(system(sprintf("jq '.scenes.%s.methods | length' %s", scene, file)))
-S = int(system(sprintf("jq '.scenes.%s.initial_states | length' %s", scene, file)))
-pts(i, j) = sprintf("< jq -r '.scenes.%s.methods[%d].runs[%d] | [.z, .zd] | transpose[] | select(.[0] != null and .[1] != null) | @tsv' %s", scene, i, j, file)
-title(i) = system(sprintf("jq -r '.scenes.%s.methods[%d] | \"\\(.label): thickness x\\(.summary.median_thickness_ratio // \"-\" | if type == \"number\" then (. * 100 | round / 100) else . end), max |R-R_0| \\(.summary.max_abs_R_error | . * 1e4 | round / 1e4)\"' %s", scene, i, file))
 set xlabel "z"
 set ylabel "dz/dt"
 set xrange [-1.6:1.6]

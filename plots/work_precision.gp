@@ -2,22 +2,26 @@
 # error over T = 10^4, every method on the same axes.
 # Called as gnuplot -e "file='results/work_precision.json'; scene='particle'; out='plots/work_precision_particle.png'" plots/work_precision.gp
 load "plots/style.gp"
+# Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
+#   N, the methods of this scene in their fixed order (style, one per style);
+#   LAB[i], STY[i] of the i-th (label, 10 + style), i = 1..N;
+#   $FINAL<i>: CPU time and error at T = 10, $ENERGY<i>: CPU time and max
+#   |E - E0| over T = 10^4, of the runs of the i-th method with status ok.
+load jq_script(sprintf("--arg scene '%s'", scene), \
+  '.scenes[$scene].runs as $runs | [$runs[] | {label: .label, style: .style}] | unique_by(.style) ' . \
+  '| "N = \(length)", "array LAB[N]", "array STY[N]", ' . \
+  '(to_entries[] | (.key + 1) as $i | .value.label as $lab ' . \
+  ' | "LAB[\($i)] = \($lab | gp)", "STY[\($i)] = 10 + int(\(.value.style | gp))", ' . \
+  '   jq_block("$FINAL\($i)"; $runs[] | select(.label == $lab and .status == "ok") | [.cpu_final, .final_error]), ' . \
+  '   jq_block("$ENERGY\($i)"; $runs[] | select(.label == $lab and .status == "ok") | [.cpu_energy, .max_energy_error])), ' . \
+  '"jq_ok = 1"', file)
+if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s, no figure drawn", out, file) }
+lab(i) = LAB[i]
+sty(i) = STY[i]
 set key noenhanced  # method labels contain underscores
 set terminal pngcairo size 1400,600 enhanced font "DejaVu Sans,10" linewidth 1.2
 set output out
 set datafile separator "\t"
-# The methods of this scene in their fixed order (style), from the JSON.
-methods = sprintf("jq -r '[.scenes.%s.runs[] | {label: .label, style: .style}] | unique_by(.style) | .[]' %s", scene, file)
-N = int(system(methods . " | jq -s length"))
-lab_of(i) = system(methods . sprintf(" | jq -s -r '.[%d].label'", i - 1))
-sty_of(i) = 10 + int(system(methods . sprintf(" | jq -s -r '.[%d].style'", i - 1)))
-# Each method's label and style read once (two jq calls each), not per use.
-array LAB[N]
-array STY[N]
-do for [j=1:N] { LAB[j] = lab_of(j); STY[j] = sty_of(j) }
-lab(i) = LAB[i]
-sty(i) = STY[i]
-pts(i, err, cpu) = sprintf("< jq -r '.scenes.%s.runs[] | select(.label == \"%s\" and .status == \"ok\") | [.%s, .%s] | @tsv' %s", scene, lab(i), cpu, err, file)
 set logscale xy
 set format x "10^{%L}"
 set format y "10^{%L}"
@@ -27,8 +31,8 @@ set multiplot layout 1,2 title sprintf("Work-precision (%s): fixed-step methods 
 set title "error in q at T = 10 against CPU time"
 set xlabel "CPU seconds per run"
 set ylabel "max_i |q_i(T) - q_{ref,i}(T)|"
-plot for [i=1:N] pts(i, "final_error", "cpu_final") u 1:2 ls sty(i) ps 0.9 t lab(i)
+plot for [i=1:N] sprintf("$FINAL%d", i) u 1:2 ls sty(i) ps 0.9 t lab(i)
 set title "largest |E - E_0| over T = 10^4 against CPU time"
 set ylabel "max |E - E_0|"
-plot for [i=1:N] pts(i, "max_energy_error", "cpu_energy") u 1:2 ls sty(i) ps 0.9 t lab(i)
+plot for [i=1:N] sprintf("$ENERGY%d", i) u 1:2 ls sty(i) ps 0.9 t lab(i)
 unset multiplot
