@@ -4,7 +4,11 @@ execute_process(COMMAND git -C "${SRC}" rev-parse HEAD OUTPUT_VARIABLE rev
 if(NOT rc EQUAL 0 OR rev STREQUAL "")
   set(rev "unknown")
 endif()
-execute_process(COMMAND git -C "${SRC}" status --porcelain --untracked-files=no
+# Dirty means the sources differ from the revision: results/ and plots/ are
+# what make reproduce writes (deleting them to regenerate everything must not
+# mark the code that regenerates them dirty).
+execute_process(COMMAND git -C "${SRC}" status --porcelain --untracked-files=no -- .
+                        ":(exclude)results" ":(exclude)plots"
                 OUTPUT_VARIABLE st ERROR_QUIET RESULT_VARIABLE rc2)
 if(rc2 EQUAL 0 AND st STREQUAL "")
   set(dirty "false")
