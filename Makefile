@@ -170,7 +170,8 @@ study-work-precision: results/step_costs.json
 # --shard: every ratio to RK4 is measured in one process); five repetitions
 # of >= 0.1 s per row, the fastest kept.  (Until issue 13's last stop: one
 # process, three repetitions of >= 0.2 s, 108 s with the second core idle;
-# the two protocols' ratios differ by as much as two runs of either.)
+# run back to back on one binary, the two protocols' ratios agree to a median
+# 0.98-1.00x, and this one varies less from run to run: README.)
 BENCH_FLAGS := --benchmark_min_time=0.1 --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
 results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 	rm -f $@.0 $@.1 $@.log.0 $@.log.1; \
