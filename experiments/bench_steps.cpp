@@ -297,12 +297,18 @@ int merge(const std::vector<std::string>& files, const std::string& out) {
       std::cerr << "bench_steps --merge: " << file << ": " << e.what() << "\n";
       return 1;
     }
-    if (!part.is_object() || part.value("study", "") != "step_costs" || !part["benchmarks"].is_array()) {
+    if (!part.is_object() || !part.contains("study") || part["study"] != "step_costs" || !part.contains("benchmarks") ||
+        !part["benchmarks"].is_array()) {
       std::cerr << "bench_steps --merge: " << file << " is not a bench_steps result\n";
       return 1;
     }
     for (const auto& r : part["benchmarks"]) {
-      if (!names.insert(r.at("name").get<std::string>()).second) {
+      if (!r.is_object() || !r.contains("name") || !r["name"].is_string() || !r.contains("cpu_ns") ||
+          !r["cpu_ns"].is_number()) {
+        std::cerr << "bench_steps --merge: " << file << " has a row without a name or cpu_ns\n";
+        return 1;
+      }
+      if (!names.insert(r["name"].get<std::string>()).second) {
         std::cerr << "bench_steps --merge: row " << r["name"] << " is in more than one shard\n";
         return 1;
       }

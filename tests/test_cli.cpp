@@ -391,4 +391,65 @@ TEST_F(Cli, InterruptedRunWritesNothing) {
   }
 }
 
+// bench_steps' shards (make reproduce runs --shard 0/2 and 1/2 side by side):
+// together they hold every row of the unsharded run, each row once, each
+// scene whole (a row's ratio to its scene's RK4 is measured in one
+// process); --merge joins shard results, recomputes each ratio against its
+// scene's RK4, and refuses a row in two shards or a file that is not a
+// bench_steps result, writing nothing.  Rows are listed, not timed
+// (--benchmark_list_tests), and the merge runs on small hand-made results.
+TEST_F(Cli, BenchShardsPartitionTheRowsAndMergeJoinsThem) {
+  auto list = [&](const std::string& args) {
+    const std::string out = path("list.txt");
+    const int status = std::system((std::string(NHI_BENCH) + " --benchmark_list_tests=true " + args + " > " + out +
+                                    " 2> " + path("list_err.txt")).c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << args;
+    std::ifstream in(out);
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty()) rows.push_back(line);
+    return rows;
+  };
+  auto scene_of = [](const std::string& row) { return row.substr(0, row.find('/')); };
+  const std::vector<std::string> all = list(""), s0 = list("--shard 0/2"), s1 = list("--shard 1/2");
+  ASSERT_GT(all.size(), 20u);
+  ASSERT_FALSE(s0.empty());
+  ASSERT_FALSE(s1.empty());
+  std::vector<std::string> joined = s0;
+  joined.insert(joined.end(), s1.begin(), s1.end());
+  std::sort(joined.begin(), joined.end());
+  std::vector<std::string> sorted = all;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(joined, sorted);  // every row once
+  for (const auto& a : s0)
+    for (const auto& b : s1) EXPECT_NE(scene_of(a), scene_of(b)) << a << " and " << b;  // scenes whole
+  for (const auto& shards : {std::vector<std::string>{"--shard 2/2"}, {"--shard 1/0"}, {"--shard x"}, {"--shard 1/2/3"}})
+    EXPECT_EQ(std::system((std::string(NHI_BENCH) + " " + shards[0] + " > /dev/null 2>&1").c_str()) >> 8, 2) << shards[0];
+
+  auto row = [](const std::string& name, double ns) { return json{{"name", name}, {"cpu_ns", ns}}; };
+  const std::string a = write("a.json", json{{"study", "step_costs"},
+                                             {"benchmarks", {row("particle/rk4", 40), row("particle/mp06", 50)}}}.dump());
+  const std::string b = write("b.json", json{{"study", "step_costs"},
+                                             {"benchmarks", {row("robot/rk4", 100), row("robot/mp06", 90)}}}.dump());
+  const std::string out = path("merged.json");
+  auto merge = [&](const std::string& files) {
+    return std::system((std::string(NHI_BENCH) + " --merge " + files + " -o " + out + " 2> " + path("merge_err.txt")).c_str()) >> 8;
+  };
+  ASSERT_EQ(merge(a + " " + b), 0);
+  const json m = json::parse(std::ifstream(out));
+  ASSERT_EQ(m["benchmarks"].size(), 4u);
+  for (const auto& r : m["benchmarks"]) {
+    const double expect = r["name"] == "particle/mp06" ? 50.0 / 40 : r["name"] == "robot/mp06" ? 0.9 : 1.0;
+    EXPECT_DOUBLE_EQ(r["ratio_to_rk4"].get<double>(), expect) << r["name"];
+  }
+  fs::remove(out);
+  const std::string bad = write("bad.json", R"({"study": "convergence", "benchmarks": []})");
+  const std::string nameless = write("nameless.json", R"({"study": "step_costs", "benchmarks": [{"cpu_ns": 1}]})");
+  const std::string broken = write("broken.json", R"({"study": "step_costs", "bench)");
+  for (const std::string& files : {a + " " + a, a + " " + bad, nameless, broken, a + " " + path("missing.json")}) {
+    EXPECT_EQ(merge(files), 1) << files;
+    EXPECT_FALSE(fs::exists(out)) << files;
+  }
+}
+
 }  // namespace
