@@ -173,13 +173,14 @@ study-work-precision: results/step_costs.json
 # run back to back on one binary, the two protocols' ratios agree to a median
 # 0.98-1.00x, and this one varies less from run to run: README.)
 BENCH_FLAGS := --benchmark_min_time=0.1 --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
+# The shards' results and logs go to a temporary directory, never results/.
 results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
-	rm -f $@.0 $@.1 $@.log.0 $@.log.1; \
-	$< $(BENCH_FLAGS) --shard 0/2 -o $@.0 > $@.log.0 2>&1 & pid=$$!; \
-	$< $(BENCH_FLAGS) --shard 1/2 -o $@.1 > $@.log.1 2>&1; rc1=$$?; wait $$pid; rc0=$$?; \
-	cat $@.log.0 $@.log.1; rm -f $@.log.0 $@.log.1; \
-	if [ $$rc0 -ne 0 ] || [ $$rc1 -ne 0 ]; then rm -f $@.0 $@.1; echo "bench_steps failed" >&2; exit 1; fi; \
-	$< --merge $@.0 $@.1 -o $@; rc=$$?; rm -f $@.0 $@.1; exit $$rc
+	d=$$(mktemp -d) && { \
+	  $< $(BENCH_FLAGS) --shard 0/2 -o $$d/0.json > $$d/0.log 2>&1 & pid=$$!; \
+	  $< $(BENCH_FLAGS) --shard 1/2 -o $$d/1.json > $$d/1.log 2>&1; rc1=$$?; wait $$pid; rc0=$$?; \
+	  cat $$d/0.log $$d/1.log; \
+	  if [ $$rc0 -ne 0 ] || [ $$rc1 -ne 0 ]; then echo "bench_steps failed" >&2; rc=1; \
+	  else $< --merge $$d/0.json $$d/1.json -o $@; rc=$$?; fi; rm -rf $$d; exit $$rc; }
 
 # Markdown tables of the study results, quoted in README.md.
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
