@@ -19,7 +19,7 @@ jq -r "$G"'
    "| \(.[0].label) | \(map(.fitted_order | g) | join(" | ")) |")' "$R/convergence.json"
 echo
 
-echo "## Long horizon (results/long_horizon.json): 10^6 steps of the scene's h (0.2 on the paper's scenes: T = 2e5)"
+echo "## Long horizon (results/long_horizon.json): 10^6 steps of the scene's h (0.2 on the paper's scenes: T = 2e5); the reference solution $(jq -r '.config.reference_steps // 1000000 | "\(.) steps"' "$R/long_horizon.json")"
 echo
 echo "| scene | method | max \\|E-E0\\| | drift rate (per unit t) | envelope exponent | max \\|constraint\\| | fate | CPU s |"
 echo "|---|---|---|---|---|---|---|---|"

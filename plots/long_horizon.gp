@@ -4,7 +4,8 @@
 load "plots/style.gp"
 # Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
 #   N; LABEL, GROUP, STY[i + 1] of method i (label: fate, group, 10 + style);
-#   H (as text: the title prints it as is), T; FI, the names of the first
+#   H (as text: the title prints it as is), T; RS, the reference solution's
+#   steps (config.reference_steps; 10^6 before it was recorded); FI, the names of the first
 #   integrals besides E (the contact oscillators: H_y, R), from method 0;
 #   $E<i>, $C<i>: t and max |E - E0|, max constraint of method i if in the
 #   "main" group, $V<i>: t and max |E - E0| if in the "variant" group;
@@ -14,7 +15,7 @@ load "plots/style.gp"
 load jq_script(sprintf("--arg scene '%s'", scene), \
   '.scenes[$scene] as $s | ($s.methods[0].first_integrals // {} | keys) as $fi ' . \
   '| "N = \($s.methods | length)", "array LABEL[N]", "array GROUP[N]", "array STY[N]", ' . \
-  '"H = \($s.h | gp)", "T = real(\($s.T | gp))", "FI = \($fi | join(" ") | gp)", ' . \
+  '"H = \($s.h | gp)", "T = real(\($s.T | gp))", "RS = \(.config.reference_steps // 1000000 | gp)", "FI = \($fi | join(" ") | gp)", ' . \
   '($s.methods | to_entries[] | .key as $i | .value ' . \
   ' | "LABEL[\($i + 1)] = \("\(.label): \(.fate)" | gp)", "GROUP[\($i + 1)] = \(.group | gp)", ' . \
   '   "STY[\($i + 1)] = 10 + int(\(.style // 12 | gp))", ' . \
@@ -39,7 +40,7 @@ set key outside below font ",8" spacing 0.9 maxrows 6
 set xrange [H:1.5*T]
 set style data lines
 if (strlen(FI) > 0) { set terminal pngcairo size 1500,1300 enhanced font "DejaVu Sans,10" linewidth 1.2; set output out }
-set multiplot layout (strlen(FI) > 0 ? 2 : 1),3 title sprintf("Long horizon, h = %s, 10^6 steps, T = %.4g (%s)", H, T, scene) noenhanced
+set multiplot layout (strlen(FI) > 0 ? 2 : 1),3 title sprintf("Long horizon, h = %s, 10^6 steps, T = %.4g (%s; the reference solution: %.0e steps)", H, T, scene, RS) noenhanced
 set title "max_{s <= t} |E - E_0|"
 set yrange [1e-17:1e3]
 plot for [i=0:N-1] sprintf("$E%d", i) u 1:2 ls sty(i) t (group(i) eq "main" ? label(i) : "")
