@@ -15,7 +15,7 @@ load "plots/style.gp"
 load jq_script(sprintf("--arg scene '%s'", scene), \
   '.scenes[$scene] as $s | ($s.methods[0].first_integrals // {} | keys) as $fi ' . \
   '| "N = \($s.methods | length)", "array LABEL[N]", "array GROUP[N]", "array STY[N]", ' . \
-  '"H = \($s.h | gp)", "T = real(\($s.T | gp))", "RS = \(.config.reference_steps // 1000000 | gp)", "FI = \($fi | join(" ") | gp)", ' . \
+  '"H = \($s.h | gp)", "T = real(\($s.T | gp))", "RS = real(\(.config.reference_steps // 1000000 | gp))", "FI = \($fi | join(" ") | gp)", ' . \
   '($s.methods | to_entries[] | .key as $i | .value ' . \
   ' | "LABEL[\($i + 1)] = \("\(.label): \(.fate)" | gp)", "GROUP[\($i + 1)] = \(.group | gp)", ' . \
   '   "STY[\($i + 1)] = 10 + int(\(.style // 12 | gp))", ' . \
