@@ -44,7 +44,8 @@ constexpr double kT_long = 1e6;
 // tolerance and ended with a larger energy error (1e-11: 6.9 s, 5.8e-6
 // against 2.9 s, 4.6e-6; 1e-12: 11.0 s, 5.9e-7 against 3.4 s, 4.0e-7; 1e-13:
 // 16.9 s, 5.9e-8 against 4.8 s, 2.8e-8), so none was on the particle's
-// 10^6 front; they took 38 of the study's 325 CPU s.
+// 10^6 front; their cells took 38 of the study's 325 CPU s of cell time
+// (NHI_STUDY_CELL_TIMES=1, a standalone run of 7c2a10a's code).
 constexpr double kTightestTolLongDopri5 = 1e-10;
 const std::vector<std::string> kLongScenes = {"particle"};
 constexpr double kSelfTimed = 0.5;  // s (see cpu_energy below)
