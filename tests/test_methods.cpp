@@ -317,8 +317,10 @@ TYPED_TEST(ReversibleSceneContract, SymmetricMethodsKeepTheEnergyBounded) {
 // equations are solved to their rounding floor, which leaves each step's
 // energy change at a few eps of |T| + |U| (kinetic and potential parts, the
 // robot's potential swings to 10 while E = 1.5), and those errors do not
-// cancel.  Measured: particle 3.2e-14, robot 2.2e-11 (largest single step
-// 7e-13); the bound below is 4 eps (|T| + |U|)_max per step, N steps.
+// cancel.  Measured (09ccceb): the plain scheme 1.95e-14 on the particle and
+// 1.23e-12 on the robot, its triple jump 8.3e-14 and 1.33e-10 (0.70 of the
+// bound); the bound below is 4 eps (|T| + |U|)_max
+// per step, N steps.
 // A second-order method that does not preserve it has 1e-3 ... 1e-1 here.
 TYPED_TEST(MethodContract, EnergyPreservingMethodsKeepItToRoundOff) {
   using S = TypeParam;
