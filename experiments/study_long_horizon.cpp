@@ -14,7 +14,7 @@
 // 10^6 until issue 13's last stop).  Over 10^6 steps its six runs took 152
 // of the study's 333 CPU s and most of make reproduce's untimed phase (CVODE
 // makes ~12 internal steps per step of h, 3.7 us each on the robot); over
-// 10^5 it still shows its energy drifting (README, "Long horizons").
+// 10^5 it still shows its energy drifting (README, "Energy and constraints over long horizons").
 #include "study.hpp"
 
 namespace {
