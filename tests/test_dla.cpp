@@ -416,6 +416,49 @@ TYPED_TEST(DlaPredictorTest, PassesWithTheCurvatureOfOneCoordinateAreNewtonSteps
   }
 }
 
+// The Gauss-Seidel pass (DlaStepper::run_passes): where the rule has no
+// interior node (kappa = 0: the symmetric rule alpha = 0 and alpha = 0) and the
+// constraint rows read only coordinates the constraint force does not move,
+// the first pass puts those coordinates, exact whatever the multipliers, into
+// the guess before it takes Omega, and is then exact in every coordinate: the
+// guess after one pass is q_{k+1} to round-off, while the extrapolation is
+// not (a Jacobi pass, Omega at the extrapolation, is exact only in those
+// coordinates).  The stepper relies on it to make one pass (first_pass_exact).
+template <class S, class D>
+void expect_first_pass_exact(const D& disc, double h) {
+  constexpr int n = S::n;
+  const S sys = make_system<S>();
+  Vec<double, n> q0, v0;
+  scene_state<S>(&q0, &v0);
+  DlaStepper<S, D> st(sys, disc);
+  if (!st.first_pass_exact()) return;
+  st.start(q0, v0);
+  for (int k = 0; k < 25; ++k) ASSERT_TRUE(st.step(h).ok());
+  Vec<double, n> guess[2];
+  typename DlaStepper<S, D>::VecM l;
+  for (int p = 0; p < 2; ++p) st.next_guess(h, &guess[p], &l, p);
+  ASSERT_TRUE(st.step(h).ok());
+  const Vec<double, n> q_next = st.phase().template head<n>();
+  const double size = q_next.cwiseAbs().maxCoeff() + 1.0;
+  const std::string what = std::string(S::name) + " " + disc.name() + " h " + std::to_string(h);
+  EXPECT_GT((guess[0] - q_next).cwiseAbs().maxCoeff() / size, 1e-8) << what << ": nothing left to converge";
+  EXPECT_LE((guess[1] - q_next).cwiseAbs().maxCoeff() / size, 64 * kEps) << what;
+}
+
+TYPED_TEST(DlaPredictorTest, GaussSeidelFirstPassIsExactWhereTheConstraintForceMissesOmega) {
+  for (double h : {0.2, 0.1, 0.05}) {
+    expect_first_pass_exact<TypeParam>(SymmetricDiscretization{0.0}, h);
+    expect_first_pass_exact<TypeParam>(AlphaDiscretization{0.0}, h);
+  }
+}
+
+TEST(DlaPredictor, GaussSeidelFirstPassAppliesToThePapersScenes) {  // (so the test above asserts something)
+  EXPECT_TRUE((DlaStepper<Particle, SymmetricDiscretization>(Particle{}, SymmetricDiscretization{0.0}).first_pass_exact()));
+  EXPECT_TRUE((DlaStepper<Robot, SymmetricDiscretization>(make_system<Robot>(), SymmetricDiscretization{0.0})
+                   .first_pass_exact()));
+  EXPECT_FALSE((DlaStepper<Particle, AlphaDiscretization>(Particle{}, AlphaDiscretization{0.5}).first_pass_exact()));
+}
+
 TEST(DlaTraits, MethodsKnowTheirOrder) {
   EXPECT_EQ(AlphaDiscretization{0.5}.order(), 2);
   EXPECT_TRUE(AlphaDiscretization{0.5}.symmetric());

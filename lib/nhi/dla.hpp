@@ -289,13 +289,14 @@ class DlaStepper {
   // Fixed-point passes of the predictor (next_guess).  A pass is a short
   // chain of dependent operations, cheap in instructions but not in latency,
   // so passes pay only where they end in a guess the residual check accepts
-  // (no Jet evaluation and no iteration): the symmetric rule's settles at its
-  // second pass on the structured scenes (the third only confirms it), and
-  // any rule's at small h.  So a step whose predecessor's guess was accepted
-  // makes kMinPasses and goes straight to the check (the check, not a third
-  // pass, confirms it); otherwise it makes kMinPasses, or kMaxPasses on every
-  // 8th step to find out, and is checked only if a pass moved nothing
-  // (issue 13; measured in the README).
+  // (no Jet evaluation and no iteration): the symmetric rule's is exact after
+  // its first pass on the structured scenes (the Gauss-Seidel pass,
+  // run_passes; the second only confirms it), and any rule's settles at small
+  // h.  So a step whose predecessor's guess was accepted makes kMinPasses (one
+  // where the first pass is exact, gs_) and goes straight to the check (the
+  // check, not a further pass, confirms it); otherwise it makes kMinPasses,
+  // or kMaxPasses on every 8th step to find out, and is checked only if a
+  // pass moved nothing (issue 13; measured in the README).
   static constexpr int kMaxPasses = 4, kMinPasses = 2;
   // Passes that take the curvature of a potential of one coordinate (next_guess)
   // converge quadratically: from the extrapolation the third is at round-off
@@ -318,6 +319,9 @@ class DlaStepper {
       Minv_ = inverse_mass_matrix(map_.system());
       passes_settle_ = constraint_force_misses_omega(map_.system());
       for (const Node& nd : map_.discretization().nodes()) kappa_ += nd.weight * nd.c * (1.0 - nd.c);
+      // With kappa = 0 and passes that settle, the Gauss-Seidel pass
+      // (run_passes) is exact in its first pass: one pass, then the check.
+      gs_ = passes_settle_ && kappa_ == 0;
       if (kappa_ != 0) {
         // The curvature of the passes is used only where K is constant (a
         // quadratic potential) and not zero (K = 0: nothing to add).
@@ -351,6 +355,9 @@ class DlaStepper {
   // Do the passes take the curvature of a potential of one coordinate at
   // every pass (next_guess), so that they converge quadratically?
   bool passes_newton_in_potential() const { return curvature_coordinate_ >= 0; }
+  // Is the first pass (Gauss-Seidel, run_passes) exact: kappa = 0 and the
+  // constraint rows read only coordinates the constraint force does not move?
+  bool first_pass_exact() const { return gs_; }
 
   MethodTraits traits() const {
     MethodTraits t;
@@ -382,7 +389,10 @@ class DlaStepper {
     bool settled = false;
     const bool accepted_last = accepted_;
     next_guess(h, &guess, &lambda_guess,
-               curvature_coordinate_ >= 0 ? kNewtonPasses : accepted_last || steps_ % 8 != 0 ? kMinPasses : kMaxPasses,
+               curvature_coordinate_ >= 0 ? kNewtonPasses
+               : gs_ && accepted_last      ? 1
+               : accepted_last || steps_ % 8 != 0 ? kMinPasses
+                                                  : kMaxPasses,
                &settled, true);
     const bool predicted = refines(h);  // next_guess refined q
     if (predicted) plain = extrapolation(h);
@@ -455,7 +465,8 @@ class DlaStepper {
   // happens for the symmetric discretization (alpha = 0) on the separable scenes whose
   // constraint rows read only coordinates the constraint force does not move
   // (the paper's, the contact and chaotic oscillators): there the first pass
-  // is exact in those coordinates and the second in all.  A non-finite pass
+  // is exact in those coordinates, which it updates before it takes Omega
+  // (Gauss-Seidel, run_passes), and so in all.  A non-finite pass
   // keeps the guess before it.
   //   Rules with an interior node (kappa = sum_c w_c c (1 - c) > 0: alpha = 1/2,
   // the paper's second-order rule) see q_guess in dL/dq too, and frozen there
@@ -609,10 +620,6 @@ class DlaStepper {
       VecM lambda = *lambda_guess;
       VecN q1;
       if constexpr (kPassesSolveMultipliers) {
-        Mat<double, m, n> Om = Mat<double, m, n>::Zero();
-        int node = 0;
-        for (const Node& nd : disc.constraint_nodes())  // (OmegaMemo: the robot's theta is exact after one pass)
-          Om += nd.weight * omega_memo_.at(sys, node++, VecN((1.0 - nd.c) * q + nd.c * *q_guess));
         Mat<double, m, m> Sinv;
         // The curvature of a potential of one coordinate r: the first line of
         // eq. (6), linearized in q_next at the guess, is
@@ -627,6 +634,33 @@ class DlaStepper {
           z = Minv_ * u;
           if (std::abs(1.0 - z[r]) > 0.5) zs = 1.0 / (1.0 - z[r]);
         }
+        const bool plain = !(kNewton && zs != 0) && !curved;
+        VecN vfree;  // the plain pass's V(qbar, rhs)
+        if (plain) {
+          if (!vwt_ready) {  // V(q, .) does not depend on q here: the same for every pass
+            for (int a = 0; a < m; ++a) VWt.col(a) = velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
+            vwt_ready = true;  // (Newton passes can hand over to these after pass 0, at large h)
+          }
+          // Gauss-Seidel: in a coordinate whose row of V(q, W^T) is zero (one
+          // the constraint force does not move) this pass's q1 is
+          // q + h V(qbar, rhs), whatever the multipliers, so it goes into the
+          // guess before Omega is taken at the constraint nodes.  Where the
+          // constraint rows read only such coordinates (passes_settle_) the
+          // first pass is then exact in every coordinate, not the second, and
+          // with kappa = 0 the stepper makes one pass before the residual
+          // check (gs_, step()).  Measured in one scratch run at h = 0.2 (ns
+          // per step, 3 interleaved pairs): symmetric rule, particle 172-177
+          // -> 149, robot and contact oscillator -10 %; alpha = 0 particle
+          // -8 %; the particle's and the robot's symmetric runs bit-identical
+          // over 10^5 steps.
+          vfree = velocity<S, double>(sys, qbar, rhs);
+          for (int i = 0; i < n; ++i)
+            if ((VWt.row(i).array() == 0.0).all()) (*q_guess)[i] = q[i] + h * vfree[i];
+        }
+        Mat<double, m, n> Om = Mat<double, m, n>::Zero();
+        int node = 0;
+        for (const Node& nd : disc.constraint_nodes())  // (OmegaMemo: the robot's theta is exact after one pass)
+          Om += nd.weight * omega_memo_.at(sys, node++, VecN((1.0 - nd.c) * q + nd.c * *q_guess));
         if (kNewton && zs != 0) {
           if (!rank_one_started) {  // (W^T is the step's: once)
             MWt = Minv_ * Wt;
@@ -645,13 +679,9 @@ class DlaStepper {
           lambda = Sinv * VecM(Om * Prhs);
           q1 = q + h * VecN(Prhs - PWt * lambda);
         } else {
-          if (!vwt_ready) {  // V(q, .) does not depend on q here: the same for every pass
-            for (int a = 0; a < m; ++a) VWt.col(a) = velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
-            vwt_ready = true;  // (Newton passes can hand over to these after pass 0, at large h)
-          }
           const Mat<double, m, m> A = Om * VWt;
           Sinv = A.inverse();
-          lambda = Sinv * VecM(Om * velocity<S, double>(sys, qbar, rhs));
+          lambda = Sinv * VecM(Om * vfree);
           q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
         }
         polish_Om_ = Om;  // for polish(), from the last pass
@@ -791,6 +821,7 @@ class DlaStepper {
   long steps_ = 0;
   double h_ = 0, h_prev_ = 0;
   bool passes_settle_ = false;  // constraint_force_misses_omega (separable systems)
+  bool gs_ = false;             // passes_settle_ and kappa = 0: one pass after an accepted guess
   bool accepted_ = false;  // did the residual check accept the last step's guess?
   // The last pass's matrices for polish(): Omega, (Omega G W^T)^-1, and G = P or M^-1 (W^T: guess_Wt_).
   mutable Mat<double, Map::mc, n> polish_Om_ = Mat<double, Map::mc, n>::Zero();
