@@ -589,6 +589,15 @@ class DlaStepper {
     bool rank_one_started = false;
     Mat<double, n, Map::mc> VWt;  // V(q, W^T e_a) (separable: independent of q)
     bool vwt_ready = false;
+    // V(q, .) does not depend on q here: the same for every pass (Newton
+    // passes can hand over to the plain ones after pass 0, at large h).
+    const auto plain_forms = [&](const VecN& qbar) {
+      if constexpr (kPassesSolveMultipliers) {
+        if (vwt_ready) return;
+        for (int a = 0; a < m; ++a) VWt.col(a) = velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
+        vwt_ready = true;
+      }
+    };
     // A potential of one coordinate r (see above): the curvature
     // u = h^2 sum_c w_c c (1 - c) d(dL/dq)/dq_r at the nodes, by a Jet of one
     // derivative at every pass.
@@ -634,13 +643,9 @@ class DlaStepper {
           z = Minv_ * u;
           if (std::abs(1.0 - z[r]) > 0.5) zs = 1.0 / (1.0 - z[r]);
         }
-        const bool plain = !(kNewton && zs != 0) && !curved;
         VecN vfree;  // the plain pass's V(qbar, rhs)
-        if (plain) {
-          if (!vwt_ready) {  // V(q, .) does not depend on q here: the same for every pass
-            for (int a = 0; a < m; ++a) VWt.col(a) = velocity<S, double>(sys, qbar, VecN(Wt.col(a)));
-            vwt_ready = true;  // (Newton passes can hand over to these after pass 0, at large h)
-          }
+        if (gs_) {  // (then kappa = 0: neither curvature applies, the pass is the plain one below)
+          plain_forms(qbar);
           // Gauss-Seidel: in a coordinate whose row of V(q, W^T) is zero (one
           // the constraint force does not move) this pass's q1 is
           // q + h V(qbar, rhs), whatever the multipliers, so it goes into the
@@ -648,11 +653,19 @@ class DlaStepper {
           // constraint rows read only such coordinates (passes_settle_) the
           // first pass is then exact in every coordinate, not the second, and
           // with kappa = 0 the stepper makes one pass before the residual
-          // check (gs_, step()).  Measured in one scratch run at h = 0.2 (ns
-          // per step, 3 interleaved pairs): symmetric rule, particle 172-177
-          // -> 149, robot and contact oscillator -10 %; alpha = 0 particle
-          // -8 %; the particle's and the robot's symmetric runs bit-identical
-          // over 10^5 steps.
+          // check (gs_, step()).  Measured against 6774139, the code before
+          // it (bench_steps at h = 0.2, four pairs of runs side by side, one
+          // on each core, ns per step, base -> this): the symmetric rule
+          // alpha = 0, particle 152-163 -> 130-147 (3.68-3.97x -> 3.17-3.54x
+          // RK4), robot 325-365 -> 287-306, contact oscillator 129-145 ->
+          // 119-125, chaotic oscillator 193-246 -> 164-191; alpha = 0, robot
+          // 274-302 -> 241-250, chaotic oscillator 151-157 -> 127-139, the
+          // particle and the contact oscillator within the noise; the other
+          // rules unchanged.  Only there: applied to every plain pass, also
+          // with kappa > 0 on a non-quadratic potential (passes that do not
+          // settle and hand over to Newton), it made the contact
+          // oscillator's midpoint DLA 9-16 % slower in four such pairs, with
+          // the same Newton iterations.
           vfree = velocity<S, double>(sys, qbar, rhs);
           for (int i = 0; i < n; ++i)
             if ((VWt.row(i).array() == 0.0).all()) (*q_guess)[i] = q[i] + h * vfree[i];
@@ -679,6 +692,8 @@ class DlaStepper {
           lambda = Sinv * VecM(Om * Prhs);
           q1 = q + h * VecN(Prhs - PWt * lambda);
         } else {
+          plain_forms(qbar);
+          if (!gs_) vfree = velocity<S, double>(sys, qbar, rhs);
           const Mat<double, m, m> A = Om * VWt;
           Sinv = A.inverse();
           lambda = Sinv * VecM(Om * vfree);
