@@ -417,7 +417,7 @@ TYPED_TEST(DlaPredictorTest, PassesWithTheCurvatureOfOneCoordinateAreNewtonSteps
 }
 
 // The Gauss-Seidel pass (DlaStepper::run_passes): where the rule has no
-// interior node (kappa = 0: the symmetric rule alpha = 0 and alpha = 0) and the
+// interior node (kappa = 0: alpha = 0 and 1, and the symmetric rule alpha = 0) and the
 // constraint rows read only coordinates the constraint force does not move,
 // the first pass puts those coordinates, exact whatever the multipliers, into
 // the guess before it takes Omega, and is then exact in every coordinate: the
@@ -449,6 +449,7 @@ TYPED_TEST(DlaPredictorTest, GaussSeidelFirstPassIsExactWhereTheConstraintForceM
   for (double h : {0.2, 0.1, 0.05}) {
     expect_first_pass_exact<TypeParam>(SymmetricDiscretization{0.0}, h);
     expect_first_pass_exact<TypeParam>(AlphaDiscretization{0.0}, h);
+    expect_first_pass_exact<TypeParam>(AlphaDiscretization{1.0}, h);
   }
 }
 
