@@ -156,5 +156,31 @@ TYPED_TEST(SystemTest, EnergyIsConservedAlongTheBenchmark) {
   EXPECT_LT(worst, 1e-9 * (1 + std::abs(E0)));
 }
 
+// particle.hpp writes omega's first two entries as one pair (-y)(1, 0), for
+// speed (issue 13): it is still the paper's row (-y, 0, 1), in double and in
+// the Jet the solver differentiates, whatever the sign and size of y.
+TEST(Particle, OmegaIsThePapersRowWrittenAsOnePair) {
+  const Particle sys;
+  for (double y : {0.5, -0.5, 0.0, -0.0, 1e300, -3e-310}) {
+    const Vec<double, 3> q(0.7, y, -1.3);
+    const Mat<double, 1, 3> w = sys.omega<double>(q);
+    EXPECT_EQ(w[0], -y) << y;
+    EXPECT_EQ(w[1], 0.0) << y;
+    EXPECT_EQ(w[2], 1.0) << y;
+    using J = ceres::Jet<double, 3>;
+    Vec<J, 3> qj;
+    for (int i = 0; i < 3; ++i) qj[i] = J(q[i], i);
+    const Mat<J, 1, 3> wj = sys.omega<J>(qj);
+    EXPECT_EQ(wj[0].a, -y);
+    EXPECT_EQ(wj[1].a, 0.0);
+    EXPECT_EQ(wj[2].a, 1.0);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(wj[0].v[i], i == 1 ? -1.0 : 0.0) << y << " " << i;
+      EXPECT_EQ(wj[1].v[i], 0.0) << y << " " << i;
+      EXPECT_EQ(wj[2].v[i], 0.0) << y << " " << i;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace nhi::test
