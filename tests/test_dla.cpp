@@ -379,14 +379,6 @@ TEST(DlaPredictor, PassesExactInThePotentialOnAQuadraticPotential) {
   EXPECT_FALSE((DlaStepper<ChaoticOscillator, AlphaDiscretization>(ChaoticOscillator{}, {0.5}).passes_newton_in_potential()));
 }
 
-// Where the passes take the curvature of a potential of one coordinate
-// (DlaStepper::passes_newton_in_potential), each pass is a Newton step in the
-// potential: the error after pass p + 1 is of the order of the square of the
-// error after pass p (relative to the state's size), not a fixed factor of it,
-// and the third pass is at round-off (kNewtonPasses).  Linear passes gain
-// ~h^2 kappa |d^2 U| per pass (0.02 on the robot at h = 0.2), far above what is
-// asserted for the second pass here.  On every separable scene whose potential
-// reads one coordinate, for both rules with an interior node.
 // The errors of the stepper's guesses after passes 0 .. P-1 against the
 // solved step, relative to the state's size (max |q| + 1), 25 steps into the
 // scene's default run; false, with nothing to assert, where `applies` says
@@ -420,6 +412,14 @@ bool pass_errors(const D& disc, double h, Applies applies, std::array<double, P>
   return true;
 }
 
+// Where the passes take the curvature of a potential of one coordinate
+// (DlaStepper::passes_newton_in_potential), each pass is a Newton step in the
+// potential: the error after pass p + 1 is of the order of the square of the
+// error after pass p (relative to the state's size), not a fixed factor of it,
+// and the third pass is at round-off (kNewtonPasses).  Linear passes gain
+// ~h^2 kappa |d^2 U| per pass (0.02 on the robot at h = 0.2), far above what is
+// asserted for the second pass here.  On every separable scene whose potential
+// reads one coordinate, for both rules with an interior node.
 template <class S, class D>
 void expect_newton_passes(const D& disc, double h) {
   std::array<double, 4> err;  // passes 0 .. 3
