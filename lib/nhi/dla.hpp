@@ -653,19 +653,9 @@ class DlaStepper {
           // constraint rows read only such coordinates (passes_settle_) the
           // first pass is then exact in every coordinate, not the second, and
           // with kappa = 0 the stepper makes one pass before the residual
-          // check (gs_, step()).  Measured against 6774139, the code before
-          // it (bench_steps at h = 0.2, four pairs of runs side by side, one
-          // on each core, ns per step, base -> this): the symmetric rule
-          // alpha = 0, particle 152-163 -> 130-147 (3.68-3.97x -> 3.17-3.54x
-          // RK4), robot 325-365 -> 287-306, contact oscillator 129-145 ->
-          // 119-125, chaotic oscillator 193-246 -> 164-191; alpha = 0, robot
-          // 274-302 -> 241-250, chaotic oscillator 151-157 -> 127-139, the
-          // particle and the contact oscillator within the noise; the other
-          // rules unchanged.  Only there: applied to every plain pass, also
-          // with kappa > 0 on a non-quadratic potential (passes that do not
-          // settle and hand over to Newton), it made the contact
-          // oscillator's midpoint DLA 9-16 % slower in four such pairs, with
-          // the same Newton iterations.
+          // check (gs_, step()).  Kept to kappa = 0: on every plain pass it
+          // made the contact oscillator's midpoint DLA slower (the
+          // measurements: README, "What made steps faster", d67faed/525ba90).
           vfree = velocity<S, double>(sys, qbar, rhs);
           for (int i = 0; i < n; ++i)
             if ((VWt.row(i).array() == 0.0).all()) (*q_guess)[i] = q[i] + h * vfree[i];
