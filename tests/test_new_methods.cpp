@@ -214,6 +214,57 @@ TYPED_TEST(SeparableTest, Mp06ExplicitStepIsTheNewtonStep) {
             1e-11 * (1 + direct.lambda().cwiseAbs().maxCoeff()));
 }
 
+// NewtonSolver::newton: a start already within round-off (relative residual
+// <= 16 eps) is accepted without an iteration, but moved by the update its
+// first evaluation paid the Jacobian for.  mp06's reduced problem (lambda
+// alone) at random states of every separable scene: from lambda* + d with
+// d set so that the start's relative residual is ~8 eps, the result has at
+// most half the start's residual (before the update it was the start
+// itself).  (Not its distance to lambda*: Newton's lambda* is itself
+// accepted anywhere within 16 eps, further off than d on the sleigh.)
+TYPED_TEST(SeparableTest, NewtonStartAtRoundOffTakesItsUpdate) {
+  using S = TypeParam;
+  constexpr int m = S::m;
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  int moved = 0;
+  double worst_rel = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const S rs = randomized_system<S>(rng);
+    Vec<double, S::n> q0, p0;
+    for (int i = 0; i < S::n; ++i) {
+      q0[i] = u(rng);
+      p0[i] = u(rng);
+    }
+    using P = Mp06SeparableProblem<S>;
+    const P prob(rs, 0.2, q0, p0);
+    const NewtonSolver<P> solver(prob);
+    Vec<double, m> star = Vec<double, m>::Zero();
+    Vec<double, 0> none;
+    ASSERT_TRUE(solver.solve(&star, &none).ok()) << trial;
+    // The residual is linear in d near lambda*: scale a probe to 8 eps.
+    const Vec<double, m> probe = Vec<double, m>::Constant(1e-10 * (1 + star.cwiseAbs().maxCoeff()));
+    const double rel_probe = solver.relative_residual(Vec<double, m>(star + probe), none);
+    ASSERT_GT(rel_probe, 0) << trial;
+    Vec<double, m> d = probe * (8 * kEps / rel_probe);
+    d *= 8 * kEps / solver.relative_residual(Vec<double, m>(star + d), none);  // (not quite linear on the sleigh)
+    Vec<double, m> y = star + d;
+    const double rel_start = solver.relative_residual(y, none);
+    ASSERT_GE(rel_start, 4 * kEps) << trial;
+    ASSERT_LE(rel_start, 12 * kEps) << trial;
+    const StepSummary s = solver.solve(&y, &none);
+    ASSERT_TRUE(s.ok()) << trial;
+    EXPECT_EQ(s.iterations, 0) << trial;
+    EXPECT_EQ(s.evaluations, 1) << trial;
+    const double rel = solver.relative_residual(y, none) / rel_start;
+    EXPECT_LE(rel, 0.5) << trial;
+    worst_rel = std::max(worst_rel, rel);
+    moved += (y != star + d);
+  }
+  EXPECT_EQ(moved, 20);
+  std::printf("[ %s ] start at 8 eps: residual after its update / the start's <= %.2g\n", S::name, worst_rel);
+}
+
 // The discrete gradient's fixed-point passes (DiscreteGradientStepper::passes)
 // and the residual check that accepts a settled iterate: every step of the
 // stepper solves the step's equations to round-off by the full measure (the
