@@ -25,6 +25,7 @@
 #pragma once
 
 #include <string>
+#include <type_traits>
 
 #include "nhi/composition.hpp"
 #include "nhi/hamiltonian.hpp"
@@ -202,21 +203,25 @@ struct Mp06Problem {
   }
 };
 
-// Separable form: y = lambda (m unknowns), no saddle part.
-template <class S>
+// Separable form: y = lambda (m unknowns), no saddle part.  V = M^-1 p by
+// the stepper's SeparableVelocity, or IdentityVelocity where M^-1 is the
+// identity (hamiltonian.hpp).
+template <class S, class Velocity = SeparableVelocity<S>>
 struct Mp06SeparableProblem {
   static constexpr int n = S::n, m = S::m;
   static constexpr int ny = m, nl = 0;
   using VecN = Vec<double, n>;
 
   const S& sys;
+  const Velocity& V;
   double h;
   VecN q_half, p_base;         // p1 = p_base + h omega(q_half)^T lambda, p_base = p0 + h F(q_half)
   Mat<double, n, m> hWt;       // h omega(q_half)^T
   Mat<double, ny, nl> W_t;     // empty
 
-  Mp06SeparableProblem(const S& s, double hh, const VecN& q0, const VecN& p0) : sys(s), h(hh) {
-    q_half = q0 + 0.5 * h * velocity<S, double>(sys, q0, p0);
+  Mp06SeparableProblem(const S& s, const Velocity& vel, double hh, const VecN& q0, const VecN& p0)
+      : sys(s), V(vel), h(hh) {
+    q_half = q0 + 0.5 * h * V(p0);
     // F(q_half, p) does not depend on p here, so (h/2)(F(q_half, p0) + F(q_half, p1)) = h F(q_half, p0).
     p_base = p0 + h * force<S, double>(sys, q_half, p0);
     hWt = h * sys.template omega<double>(q_half).transpose();
@@ -228,7 +233,7 @@ struct Mp06SeparableProblem {
   template <class T>
   void state(const Vec<T, m>& lambda, Vec<T, n>* q1, Vec<T, n>* p1, Vec<T, n>* v1) const {
     *p1 = p_base.template cast<T>() + hWt.template cast<T>() * lambda;
-    *v1 = velocity(sys, Vec<T, n>(q_half.template cast<T>()), *p1);  // V does not depend on q
+    *v1 = V(*p1);  // V does not depend on q
     *q1 = q_half.template cast<T>() + cst<T>(0.5 * h) * *v1;
   }
 
@@ -253,7 +258,7 @@ class Mp06Stepper {
 
   // allow_explicit = false always solves by Newton (tests compare the two).
   explicit Mp06Stepper(const S& sys, SolverOptions options = {}, bool allow_explicit = true)
-      : sys_(sys), options_(options), explicit_(allow_explicit && explicit_structure(sys)) {}
+      : sys_(sys), vel_(sys), options_(options), explicit_(allow_explicit && explicit_structure(sys)) {}
   const S& system() const { return sys_; }
 
   // Is the step explicit?  For a separable system, q1 = q_half + (h/2) V(p_base
@@ -276,7 +281,8 @@ class Mp06Stepper {
           q0[i] = probe_q(i, probe);
           p0[i] = probe_v(i, probe);
         }
-        const Mp06SeparableProblem<S> prob(sys, 0.3, q0, p0);
+        const SeparableVelocity<S> vel(sys);
+        const Mp06SeparableProblem<S> prob(sys, vel, 0.3, q0, p0);
         Vec<J, m> lj;
         for (int a = 0; a < m; ++a) lj[a] = J(0.1 * (a + 1), a);
         Vec<J, n> q1, p1, v1;
@@ -313,16 +319,9 @@ class Mp06Stepper {
   StepSummary map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecM* lambda) const {
     StepSummary s;
     if constexpr (kSeparable) {
-      const Mp06SeparableProblem<S> prob(sys_, h, q0, p0);
-      if (explicit_ && explicit_map(prob, q1, p1, lambda, &s)) return s;
-      VecM y = *lambda;
-      Vec<double, 0> none;
-      s = NewtonSolver<Mp06SeparableProblem<S>>(prob, options_).solve(&y, &none);
-      if (s.ok()) {
-        VecN v1;
-        prob.state(y, q1, p1, &v1);
-        *lambda = y;
-      }
+      // One test per step picks V (SeparableVelocity in hamiltonian.hpp).
+      if (vel_.identity()) return map_separable(IdentityVelocity{}, h, q0, p0, q1, p1, lambda);
+      return map_separable(vel_, h, q0, p0, q1, p1, lambda);
     } else {
       const Mp06Problem<S> prob(sys_, h, q0, p0);
       Vec<double, n> y = prob.guess(q0, *lambda);
@@ -336,17 +335,36 @@ class Mp06Stepper {
     return s;
   }
 
+  template <class Velocity>
+  StepSummary map_separable(const Velocity& V, double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1,
+                            VecM* lambda) const {
+    StepSummary s;
+    const Mp06SeparableProblem<S, Velocity> prob(sys_, V, h, q0, p0);
+    if (explicit_ && explicit_map(prob, q1, p1, lambda, &s)) return s;
+    VecM y = *lambda;
+    Vec<double, 0> none;
+    s = NewtonSolver<Mp06SeparableProblem<S, Velocity>>(prob, options_).solve(&y, &none);
+    if (s.ok()) {
+      VecN v1;
+      prob.state(y, q1, p1, &v1);
+      *lambda = y;
+    }
+    return s;
+  }
+
   // The explicit step (see explicit_structure()): with lambda = 0, q1* and
   // v1* = V(p_base); omega(q1*) = omega(q1) for every lambda, and V is linear in
   // p, so omega(q1*) [v1* + sum_a lambda_a V(h omega(q_half)^T e_a)] = 0 is an
   // m x m linear system.  The result is checked by one evaluation of the
   // residual; if it is not within tolerance the caller falls back to Newton.
-  bool explicit_map(const Mp06SeparableProblem<S>& prob, VecN* q1, VecN* p1, VecM* lambda, StepSummary* s) const {
+  template <class Velocity>
+  bool explicit_map(const Mp06SeparableProblem<S, Velocity>& prob, VecN* q1, VecN* p1, VecM* lambda,
+                    StepSummary* s) const {
     VecN qs, ps, vs;
     prob.template state<double>(VecM::Zero(), &qs, &ps, &vs);
     const Mat<double, m, n> W1 = sys_.template omega<double>(qs);
     Mat<double, m, m> A;
-    for (int a = 0; a < m; ++a) A.col(a) = W1 * velocity<S, double>(sys_, prob.q_half, VecN(prob.hWt.col(a)));
+    for (int a = 0; a < m; ++a) A.col(a) = W1 * prob.V(VecN(prob.hWt.col(a)));
     // Closed-form m x m inverse (m <= 4); a nearly singular A goes to Newton.
     const double det = A.determinant();
     double amax = A.cwiseAbs().maxCoeff(), scale = 1;
@@ -357,8 +375,9 @@ class Mp06Stepper {
     prob.template state<double>(l, &qn, &pn, &vn);
     // The residual omega(q1) V(p1).  With a hand-written V, omega(q1) is W1
     // bit for bit: the coordinates omega reads get exact zeros from the
-    // constraint force (that is what the structural probe found).  The
-    // generic V solves with pivoted LU, so there omega(q1) is evaluated.
+    // constraint force, p_i + 0, and the same products with M^-1 (that is
+    // what the structural probe found).  A system without one is not relied
+    // on to that: there omega(q1) is evaluated.
     Mat<double, m, n> W;
     if constexpr (has_velocity<S, double>::value) {
       W = W1;
@@ -424,6 +443,11 @@ class Mp06Stepper {
 
  private:
   S sys_;
+  // V = M^-1 p for the separable forms (nothing otherwise).
+  struct NoVelocity {
+    explicit NoVelocity(const S&) {}
+  };
+  std::conditional_t<kSeparable, SeparableVelocity<S>, NoVelocity> vel_;
   SolverOptions options_;
   bool explicit_ = false;
   VecN q_ = VecN::Zero(), p_ = VecN::Zero();
