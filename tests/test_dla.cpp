@@ -215,6 +215,45 @@ void expect_fast_path_exact(const D& disc, double h, long steps, const std::vect
   }
 }
 
+// p_{k+1} = D2 L_d(q_k, q_{k+1}) bit for bit, as evaluated on its own, whether
+// the stepper took it from the residual that accepted q_{k+1} (DlaMap::step)
+// or evaluated it again: on the check's path (h = 0.2), where the check's
+// second test accepts and polish() then moves q_{k+1} (h = 0.4/2^9), where
+// Newton iterates (h = 0.4 on the sleigh and the non-reversible oscillator),
+// and on a composition's stages, which turn back.  A stale D2 (one from a
+// residual at another q_{k+1}) differs from it in the last bits at least.
+TYPED_TEST(DlaTest, MomentumIsD2OfTheAcceptedStepBitForBit) {
+  using S = TypeParam;
+  constexpr int n = S::n;
+  const S sys = make_system<S>();
+  Vec<double, n> q0, v0;
+  scene_state<S>(&q0, &v0);
+  const double g1 = 1.0 / (2.0 - std::cbrt(2.0));
+  const auto check = [&](const auto& disc, double h, const std::vector<double>& gamma) {
+    using D = std::decay_t<decltype(disc)>;
+    DlaStepper<S, D> st(sys, disc);
+    st.start(q0, v0);
+    long differ = 0, iterated = 0;
+    for (long k = 0; k < 300; ++k) {
+      const double hk = gamma[k % gamma.size()] * h;
+      const Vec<double, n> q = st.phase().template head<n>();
+      const StepSummary s = st.step(hk);
+      ASSERT_TRUE(s.ok()) << S::name << " " << disc.name() << " h " << h << " step " << k << ": " << s.message;
+      if (s.iterations > 0) ++iterated;
+      const Vec<double, n> q1 = st.phase().template head<n>(), p1 = st.phase().template tail<n>();
+      Vec<double, n> d2;
+      discrete_lagrangian_slots<S, D, double>(sys, disc, hk, q, q1, nullptr, &d2);
+      if (!(d2.array() == p1.array()).all()) ++differ;
+    }
+    EXPECT_EQ(differ, 0) << S::name << " " << disc.name() << " h " << h << " (" << iterated << " steps iterated)";
+  };
+  for (double h : {0.2, 0.4 / 512, 0.4}) {
+    check(AlphaDiscretization{0.5}, h, {1.0});
+    check(SymmetricDiscretization{0.0}, h, {1.0});
+  }
+  check(AlphaDiscretization{0.5}, 0.2, {g1, 1.0 - 2.0 * g1, g1});
+}
+
 // The stepper does not evaluate omega again at a constraint node whose
 // coordinates omega reads are the same bits (OmegaMemo, issue 13).  That is
 // right only if omega_reads() (dla.hpp) finds every coordinate omega depends on: here a
