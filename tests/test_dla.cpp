@@ -219,8 +219,10 @@ void expect_fast_path_exact(const D& disc, double h, long steps, const std::vect
 // the stepper took it from the residual that accepted q_{k+1} (DlaMap::step)
 // or evaluated it again: on the check's path (h = 0.2), where the check's
 // second test accepts and polish() then moves q_{k+1} (h = 0.4/2^9), where
-// Newton iterates (h = 0.4 on the sleigh and the non-reversible oscillator),
-// and on a composition's stages, which turn back.  A stale D2 (one from a
+// Newton iterates (every step of contact_oscillator_nr, 25-90 % of the
+// sleigh's, the chaotic oscillator's midpoint rule at h = 0.2 and 0.4, and
+// the first two steps everywhere), and on a composition's stages, which
+// turn back.  A stale D2 (one from a
 // residual at another q_{k+1}) differs from it in the last bits at least.
 TYPED_TEST(DlaTest, MomentumIsD2OfTheAcceptedStepBitForBit) {
   using S = TypeParam;

@@ -439,7 +439,7 @@ class DiscreteGradientStepper {
   // constraint omega(qbar) gradbar_p H of the step that arrived at k (0 at
   // k = 0; zero to round-off).  It is evaluated here, when a point is
   // recorded, not in every step (as the DLA and mp06 do theirs): a second
-  // discrete gradient, H(q_k, p_k) and omega per step, 3-9 % of the step at
+  // discrete gradient, H(q_k, p_k) and omega per step, 3-7 % of the step at
   // h = 0.2 in a scratch run (issue 13).  The same arithmetic either way.
   void sample(Sample<n, m>* s) const {
     s->has_p = true;
