@@ -258,7 +258,7 @@ TYPED_TEST(DlaTest, MomentumIsD2OfTheAcceptedStepBitForBit) {
 
 // The stepper does not evaluate omega again at a constraint node whose
 // coordinates omega reads are the same bits (OmegaMemo, issue 13).  That is
-// right only if omega_reads() (dla.hpp) finds every coordinate omega depends on: here a
+// right only if omega_reads() (hamiltonian.hpp) finds every coordinate omega depends on: here a
 // coordinate it leaves out never changes omega, one it lists does, and the
 // memo gives omega(q) bit for bit along a sequence of states in which the
 // unread coordinates move alone.

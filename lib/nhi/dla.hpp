@@ -42,52 +42,6 @@ namespace nhi {
 
 using DlaOptions = SolverOptions;
 
-// Which coordinates does omega read?  Those with a non-zero derivative of
-// some row at one of two unrelated states (autodiff; a structural zero is
-// exactly zero).
-template <class S>
-std::array<bool, S::n> omega_reads(const S& sys) {
-  constexpr int n = S::n, m = S::m;
-  std::array<bool, n> reads{};
-  using J = ceres::Jet<double, n>;
-  for (int probe = 0; probe < 2; ++probe) {
-    Vec<J, n> qj;
-    for (int i = 0; i < n; ++i) qj[i] = J(probe_q(i, probe), i);
-    const Mat<J, m, n> W = sys.template omega<J>(qj);
-    for (int a = 0; a < m; ++a)
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-          if (!(W(a, j).v[i] == 0.0)) reads[i] = true;
-  }
-  return reads;
-}
-
-// Does the constraint force leave alone every coordinate omega reads?  On a
-// separable system the force omega^T lambda moves the coordinates of the
-// non-zero rows of M^-1 omega^T; true when none of them is read by omega (at
-// both probe states; hamiltonian.hpp).  The particle, the robot and the
-// oscillators: yes; the sleigh (omega reads theta, the force turns it): no.
-// (It is the structure that makes mp06's step explicit,
-// Mp06Stepper::explicit_structure; false on a system that is not separable.)
-template <class S>
-bool constraint_force_misses_omega(const S& sys) {
-  if constexpr (!is_separable<S>::value) {
-    return false;
-  } else {
-    constexpr int n = S::n;
-    const std::array<bool, n> reads = omega_reads(sys);
-    const Mat<double, n, n> Minv = inverse_mass_matrix(sys);
-    for (int probe = 0; probe < 2; ++probe) {
-      Vec<double, n> q;
-      for (int i = 0; i < n; ++i) q[i] = probe_q(i, probe);
-      const Mat<double, n, S::m> moved = Minv * sys.template omega<double>(q).transpose();
-      for (int j = 0; j < n; ++j)
-        if (reads[j] && !(moved.row(j).array() == 0.0).all()) return false;
-    }
-    return true;
-  }
-}
-
 // omega at the constraint nodes of the last evaluations, keyed by the
 // coordinates omega reads (omega_reads above): a node whose read
 // coordinates are the same bits gets the same omega without evaluating it.

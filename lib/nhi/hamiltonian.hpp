@@ -144,8 +144,9 @@ struct IdentityVelocity {
 };
 
 // Coordinate i of two unrelated states (probe 0 and 1) at which the structural
-// probes look: constant_force_jacobian and force_reads below, omega_reads
-// (dla.hpp) and Mp06Stepper::explicit_structure (mp06.hpp).  A structural zero
+// probes look: constant_force_jacobian, force_reads, omega_reads and
+// constraint_force_misses_omega below, and Mp06Stepper::explicit_structure
+// (mp06.hpp).  A structural zero
 // of a derivative is exactly zero at both; a coincidental one is not.
 inline double probe_q(int i, int probe) { return 0.31 + 0.17 * i - 0.45 * probe + 0.05 * i * i; }
 inline double probe_v(int i, int probe) { return -0.23 + 0.29 * i + 0.37 * probe - 0.07 * i * i; }
@@ -193,6 +194,54 @@ inline std::array<bool, S::n> force_reads(const S& sys) {
         if (!(K(i, j) == 0.0)) reads[j] = true;
   }
   return reads;
+}
+
+// Which coordinates does omega read?  Those with a non-zero derivative of
+// some row at one of two unrelated states (autodiff; a structural zero is
+// exactly zero).
+template <class S>
+inline std::array<bool, S::n> omega_reads(const S& sys) {
+  constexpr int n = S::n, m = S::m;
+  std::array<bool, n> reads{};
+  using J = ceres::Jet<double, n>;
+  for (int probe = 0; probe < 2; ++probe) {
+    Vec<J, n> qj;
+    for (int i = 0; i < n; ++i) qj[i] = J(probe_q(i, probe), i);
+    const Mat<J, m, n> W = sys.template omega<J>(qj);
+    for (int a = 0; a < m; ++a)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+          if (!(W(a, j).v[i] == 0.0)) reads[i] = true;
+  }
+  return reads;
+}
+
+// Does the constraint force leave alone every coordinate omega reads?  On a
+// separable system the force omega^T lambda moves the coordinates of the
+// non-zero rows of M^-1 omega^T; true when none of them is read by omega (at
+// both probe states above).  The particle, the robot and the
+// oscillators: yes; the sleigh (omega reads theta, the force turns it): no.
+// (It is the structure that makes mp06's step explicit,
+// Mp06Stepper::explicit_structure, the DLA's Gauss-Seidel pass exact and the
+// discrete gradient's first pass exact in a quadratic potential; false on a
+// system that is not separable.)
+template <class S>
+inline bool constraint_force_misses_omega(const S& sys) {
+  if constexpr (!is_separable<S>::value) {
+    return false;
+  } else {
+    constexpr int n = S::n;
+    const std::array<bool, n> reads = omega_reads(sys);
+    const Mat<double, n, n> Minv = inverse_mass_matrix(sys);
+    for (int probe = 0; probe < 2; ++probe) {
+      Vec<double, n> q;
+      for (int i = 0; i < n; ++i) q[i] = probe_q(i, probe);
+      const Mat<double, n, S::m> moved = Minv * sys.template omega<double>(q).transpose();
+      for (int j = 0; j < n; ++j)
+        if (reads[j] && !(moved.row(j).array() == 0.0).all()) return false;
+    }
+    return true;
+  }
 }
 
 }  // namespace nhi
