@@ -400,8 +400,7 @@ TEST(DiscreteGradientPasses, ExactInTheForceWhereItIsAffine) {
 // is then exact: the plain pass after it confirms it, and the step makes two
 // passes, not four (three exact in the force, one plain, before), on most
 // steps wherever the passes are exact in the force (rho >= 5e-4: h >= 0.05
-// here).  That
-// the accepted step is the step's solution to round-off is
+// here).  That the accepted step is the step's solution to round-off is
 // SeparableTest.DiscreteGradientPassesSolveTheStep's to check.
 TEST(DiscreteGradientPasses, GaussSeidelFirstPassIsExactOnTheParticle) {
   const Particle sys;

@@ -330,9 +330,10 @@ class DiscreteGradientStepper {
         const VecN b = p0 - h * Dq + h * (*K_ * d0);
         const VecN Qb = Q * b;
         if constexpr (m > 0) {
+          // V((p0 + p1')/2) + c dp without the constraint force's part.
+          const VecN vfree = VecN(0.5 * (Minv_ * VecN(p0 + Qb))) + cp;
           Mat<double, n, m> MQWt = MQ * W.transpose();
           if (pass == 0 && gs_ && misses_omega(MQWt)) {
-            const VecN vfree = VecN(0.5 * (Minv_ * VecN(p0 + Qb))) + cp;
             VecN qg = q1;
             for (int j = 0; j < n; ++j)
               if (omega_reads_[j]) qg[j] = q0[j] + h * vfree[j];
@@ -341,7 +342,7 @@ class DiscreteGradientStepper {
             exact = misses_omega(MQWt);
           }
           const Mat<double, m, m> A = (0.5 * h) * (W * MQWt);
-          l = -(A.inverse() * (W * VecN(0.5 * (Minv_ * VecN(p0 + Qb)) + cp)));
+          l = -(A.inverse() * (W * vfree));
           p1n = Qb + h * (Q * (W.transpose() * l));
         } else {
           p1n = Qb;

@@ -43,7 +43,7 @@ namespace nhi {
 using DlaOptions = SolverOptions;
 
 // omega at the constraint nodes of the last evaluations, keyed by the
-// coordinates omega reads (omega_reads above): a node whose read
+// coordinates omega reads (omega_reads, hamiltonian.hpp): a node whose read
 // coordinates are the same bits gets the same omega without evaluating it.
 // On the robot theta is exact after the predictor's first pass, so its
 // sincos is taken once or twice a step instead of at every pass and
