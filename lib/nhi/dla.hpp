@@ -564,6 +564,11 @@ class DlaStepper {
     const Mat<double, n, Map::mc>& Wt = guess_Wt_;
     Mat<double, n, Map::mc> MWt;  // M^-1 W^T, for the passes with the curvature of one coordinate
     bool rank_one_started = false;
+    // Their constrained inverse Pi for the Omega pi_Om, and S0 (below).
+    Mat<double, n, n> pi;
+    Mat<double, Map::mc, n> pi_Om;
+    Mat<double, Map::mc, Map::mc> pi_S0;
+    bool pi_ready = false;
     Mat<double, n, Map::mc> VWt;  // V(q, W^T e_a) (separable: independent of q)
     bool vwt_ready = false;
     // V(q, .) does not depend on q here: the same for every pass (Newton
@@ -646,12 +651,30 @@ class DlaStepper {
             MWt = Minv_ * Wt;
             rank_one_started = true;
           }
-          const Mat<double, n, m> GWt = MWt + (zs * z) * MWt.row(r);
-          const VecN y = Minv_ * VecN(rhs - vg[r] * u);
-          const VecN Grhs = y + (zs * y[r]) * z;
-          Sinv = Mat<double, m, m>(Om * GWt).inverse();
-          lambda = Sinv * VecM(Om * Grhs);
-          q1 = q + h * VecN(Grhs - GWt * lambda);
+          // The constrained inverse Pi of the plain pass, for this Omega
+          // (taken again only when Omega changes: the robot's from pass 1
+          // on, theta being exact), so that nothing but Pi times two vectors
+          // and one division follows the curvature on the pass's chain:
+          // with x = rhs' + v_r u, rhs' = rhs - vg_r u, the system is
+          // M v = x - W^T lambda, Omega v = 0, so v = Pi x and
+          // lambda = S0 Omega M^-1 x, S0 = (Omega M^-1 W^T)^-1,
+          // Pi = M^-1 - M^-1 W^T S0 Omega M^-1; its row r gives
+          // v_r = (Pi rhs')_r / (1 - (Pi u)_r).  The same system as the
+          // Sherman-Morrison form above, which took (Omega G W^T)^-1 after the
+          // curvature at every pass: measured side by side on the robot's
+          // midpoint rule at h = 0.2 (scratch loop, best of 40 x 10^5 steps,
+          // four rounds) 299-305 -> 280-286 ns per step.
+          if (!pi_ready || !(Om.array() == pi_Om.array()).all()) {
+            pi_Om = Om;
+            pi_S0 = Mat<double, m, m>(Om * MWt).inverse();
+            pi = Minv_ - MWt * Mat<double, m, n>(pi_S0 * Mat<double, m, n>(Om * Minv_));
+            pi_ready = true;
+          }
+          const VecN rhs1 = rhs - vg[r] * u;
+          const VecN Pu = pi * u, Prhs = pi * rhs1;
+          const double vr = Prhs[r] / (1.0 - Pu[r]);
+          lambda = pi_S0 * VecM(Om * VecN(Minv_ * VecN(rhs1 + vr * u)));
+          q1 = q + h * VecN(Prhs + vr * Pu);
           newton_pass = true;
         } else if (curved) {
           const VecN Prhs = curv_.current().P * VecN(rhs - curv_.current().hkK * vg);
@@ -667,7 +690,9 @@ class DlaStepper {
           q1 = q + h * velocity<S, double>(sys, qbar, VecN(rhs - Wt * lambda));
         }
         polish_Om_ = Om;  // for polish(), from the last pass
-        polish_Sinv_ = Sinv;
+        // (A Newton pass leaves (Omega G W^T)^-1 to polish(), which is rare.)
+        polish_lazy_ = newton_pass;
+        if (!newton_pass) polish_Sinv_ = Sinv;
         if constexpr (kNewton) {
           polish_zr_ = -1;
           if (zs != 0) {
@@ -724,6 +749,12 @@ class DlaStepper {
         if (polish_zr_ < 0) return y;
         return y + y[polish_zr_] * polish_z_;
       };
+      if (polish_lazy_) {  // (Omega G W^T)^-1 of the last pass, a Newton pass (run_passes)
+        const Mat<double, n, Map::mc> MWt = Minv_ * guess_Wt_;
+        const Mat<double, n, Map::mc> GWt = MWt + polish_z_ * MWt.row(polish_zr_);
+        polish_Sinv_ = Mat<double, Map::mc, Map::mc>(polish_Om_ * GWt).inverse();
+        polish_lazy_ = false;
+      }
       const VecN Grf = G(VecN(r.template head<n>()));
       const VecM dl = polish_Sinv_ * VecM(polish_Om_ * Grf + r.template tail<Map::mc>());
       const VecN q = *q1 + h * G(VecN(r.template head<n>() - guess_Wt_ * dl));
@@ -809,6 +840,7 @@ class DlaStepper {
   mutable Mat<double, Map::mc, n> polish_Om_ = Mat<double, Map::mc, n>::Zero();
   mutable Mat<double, Map::mc, Map::mc> polish_Sinv_ = Mat<double, Map::mc, Map::mc>::Zero();
   mutable bool polish_curved_ = false, polish_ok_ = false;
+  mutable bool polish_lazy_ = false;  // polish_Sinv_ is still to be taken (a Newton pass)
   mutable VecN polish_z_ = VecN::Zero();  // z / (1 - z_r) of the last pass, and r (-1: none)
   mutable int polish_zr_ = -1;
   // The one coordinate the potential reads when the passes take its curvature (-1: they do not).
