@@ -214,10 +214,13 @@ class DiscreteGradientStepper {
     // measured over ~1.1 million such steps (every separable scene, h = 0.0125
     // to 0.8, both directions) it accepted every one unchanged, so it is
     // skipped there (a check_settled_passes(true) stepper still runs it:
-    // tests/test_new_methods.cpp, DiscreteGradientPasses.SettledPassesNeedNoCheck).
-    // Measured side by side at h = 0.2 (scratch loop, best of 5 x 2e4 steps):
-    // particle 253 -> 175 ns, contact oscillator 588 -> 326, robot 1233 ->
-    // 1121.  A step so accepted reports no evaluation and relative_residual 0
+    // tests/test_new_methods.cpp, SeparableTest.DiscreteGradientSettledPassesNeedNoCheck).
+    // Not every one everywhere: over the 10^6 composed steps of the long-horizon
+    // study the contact oscillator's discrete gradient + triple jump and
+    // + order 6 moved by round-off without it (README, "What moved").
+    // Measured side by side at h = 0.2 (bench_steps, min of 3 interleaved
+    // rounds): particle 182.6 -> 151.1 ns, contact oscillator 397 -> 353,
+    // robot 1402 -> 1338.  A step so accepted reports no evaluation and relative_residual 0
     // (not evaluated).  Passes that settled by stalling at round-off still
     // go to the check, as does every step when the tolerance asked for is
     // below the check's own round-off test (16 eps: the check, not the
