@@ -432,7 +432,9 @@ TEST(DiscreteGradientPasses, ExactInTheForceWhereItIsAffine) {
 // The Gauss-Seidel first pass (DiscreteGradientStepper::passes): on the
 // particle (quadratic H, the constraint force misses y, which omega reads)
 // the first pass, exact in the force, takes y1 before it evaluates omega and
-// is then exact: the plain pass after it confirms it, and the step makes two
+// is then exact from any input (it starts from z1 = z0, map(), and a Newton
+// solve after passes that did not settle from the explicit guess, as on
+// every other scene): the plain pass after it confirms it, and the step makes two
 // passes, not four (three exact in the force, one plain, before), on most
 // steps wherever the passes are exact in the force (rho >= 5e-4: h >= 0.05
 // here).  That the accepted step is the step's solution to round-off is

@@ -189,10 +189,29 @@ class DiscreteGradientStepper {
     const Problem prob(sys_, h, q0, p0);
     // Guess: an explicit Stoermer-Verlet-like step with the last multiplier
     // (second order when lambda is), so Newton starts close.
-    const VecN qh = q0 + 0.5 * h * velocity<S, double>(sys_, q0, p0);
-    const VecN pg = p0 + h * (force<S, double>(sys_, qh, p0) + sys_.template omega<double>(qh).transpose() * *lambda);
+    const auto explicit_guess = [&] {
+      const VecN qh = q0 + 0.5 * h * velocity<S, double>(sys_, q0, p0);
+      const VecN pg = p0 + h * (force<S, double>(sys_, qh, p0) + sys_.template omega<double>(qh).transpose() * *lambda);
+      Vec<double, Problem::ny> y;
+      y << qh + 0.5 * h * velocity<S, double>(sys_, qh, pg), pg, *lambda;
+      return y;
+    };
+    // Except where the first pass is exact whatever its input (a quadratic
+    // H, passes exact in the force, and a Gauss-Seidel first pass: the
+    // particle at h >= 0.05; passes()): the guess is then only the point
+    // at which that pass's frozen quantities are taken, and at z1 = z0
+    // Gonzalez's correction is 0 with no energy to evaluate.  The passes
+    // start from (q0, p0), and the explicit guess is made only if they do
+    // not settle, for Newton.  Measured side by side on the particle at
+    // h = 0.2 (scratch loop, min of 20 x 10^5 steps, three rounds):
+    // 140-143 -> 119-120 ns per step; the steps move by round-off (issue 13).
+    bool trivial_start = false;
+    if constexpr (is_separable<S>::value) trivial_start = gs_ && curvature(h).ok;
     Vec<double, Problem::ny> y;
-    y << qh + 0.5 * h * velocity<S, double>(sys_, qh, pg), pg, *lambda;
+    if (trivial_start)
+      y << q0, p0, *lambda;
+    else
+      y = explicit_guess();
     // The passes' iterate is used only when they settle: an iterate they did
     // not settle is often already within newton()'s first test (16 eps of
     // the full scale), which it would accept without an iteration, and on
@@ -200,53 +219,66 @@ class DiscreteGradientStepper {
     // against 4e-11 from Newton's own iterations (which end far below that
     // test).
     bool settled = false;
-    settled_by_move_ = false;
     if constexpr (is_separable<S>::value) {
+      settled_by_move_ = false;
       Vec<double, Problem::ny> yp = y;
       settled = passes(prob, &yp);
-      if (settled) y = yp;
-    }
-    // Passes that ended on a plain pass settled by its move (no component
-    // moved by more than 4 eps of the terms of its residual row) are a fixed
-    // point of the step's equations to their rounding: the plain pass solves
-    // them exactly with c, omega and F frozen at its input, and its output
-    // is that input to 4 eps.  The residual check then only confirmed it:
-    // measured over ~1.1 million such steps (every separable scene, h = 0.0125
-    // to 0.8, both directions) it accepted every one unchanged, so it is
-    // skipped there (a check_settled_passes(true) stepper still runs it:
-    // tests/test_new_methods.cpp, SeparableTest.DiscreteGradientSettledPassesNeedNoCheck).
-    // Not every one everywhere: over the 10^6 composed steps of the long-horizon
-    // study the contact oscillator's discrete gradient + triple jump and
-    // + order 6 moved by round-off without it (README, "What moved").
-    // Measured side by side at h = 0.2 (bench_steps, min of 3 interleaved
-    // rounds): particle 182.6 -> 151.1 ns, contact oscillator 397 -> 353,
-    // robot 1402 -> 1338.  A step so accepted reports no evaluation and relative_residual 0
-    // (not evaluated).  Passes that settled by stalling at round-off still
-    // go to the check, as does every step when the tolerance asked for is
-    // below the check's own round-off test (16 eps: the check, not the
-    // passes, knows whether a residual meets it) (issue 13).
-    if (settled && settled_by_move_) {
-      ++settled_by_move_steps_;
-      if (!check_settled_ && options_.tolerance >= 16 * std::numeric_limits<double>::epsilon()) {
-        *q1 = y.template head<n>();
-        *p1 = y.template segment<n>(n);
-        *lambda = y.template tail<m>();
-        StepSummary s;
-        s.status = SolveStatus::kConverged;
-        return s;
+      if (settled)
+        y = yp;
+      else if (trivial_start)
+        y = explicit_guess();
+      // Passes that ended on a plain pass settled by its move (no component
+      // moved by more than 4 eps of the terms of its residual row) are a fixed
+      // point of the step's equations to their rounding: the plain pass solves
+      // them exactly with c, omega and F frozen at its input, and its output
+      // is that input to 4 eps.  The residual check then only confirmed it:
+      // measured over ~1.1 million such steps (every separable scene, h = 0.0125
+      // to 0.8, both directions) it accepted every one unchanged, so it is
+      // skipped there (a check_settled_passes(true) stepper still runs it:
+      // tests/test_new_methods.cpp, SeparableTest.DiscreteGradientSettledPassesNeedNoCheck).
+      // Not every one everywhere: over the 10^6 composed steps of the long-horizon
+      // study the contact oscillator's discrete gradient + triple jump and
+      // + order 6 moved by round-off without it (README, "What moved").
+      // Measured side by side at h = 0.2 (bench_steps, min of 3 interleaved
+      // rounds): particle 182.6 -> 151.1 ns, contact oscillator 397 -> 353,
+      // robot 1402 -> 1338.  A step so accepted reports no evaluation and relative_residual 0
+      // (not evaluated).  Passes that settled by stalling at round-off still
+      // go to the check, as does every step when the tolerance asked for is
+      // below the check's own round-off test (16 eps: the check, not the
+      // passes, knows whether a residual meets it) (issue 13).
+      // All of this sits under the separable branch, and the test's
+      // bookkeeping (a copy of the iterate, a comparison) runs only on a
+      // check_settled_passes(true) stepper: with both on the common path,
+      // the non-separable contact_oscillator_nr, whose code path this never
+      // touches, measured +15 % per step (codegen).
+      if (settled && settled_by_move_) {
+        ++settled_by_move_steps_;
+        if (check_settled_) {
+          const Vec<double, Problem::ny> y_settled = y;
+          Vec<double, 0> none;
+          StepSummary s = NewtonSolver<Problem>(prob, options_).solve(&y, &none, true);
+          if (!s.ok() || s.jacobians > 0 || !(y.array() == y_settled.array()).all()) ++settled_checks_failed_;
+          if (s.ok()) unpack(y, q1, p1, lambda);
+          return s;
+        }
+        if (options_.tolerance >= 16 * std::numeric_limits<double>::epsilon()) {
+          unpack(y, q1, p1, lambda);
+          StepSummary s;
+          s.status = SolveStatus::kConverged;
+          return s;
+        }
       }
     }
-    const Vec<double, Problem::ny> y_settled = y;
     Vec<double, 0> none;
     StepSummary s = NewtonSolver<Problem>(prob, options_).solve(&y, &none, settled);
-    if (settled && settled_by_move_ && (!s.ok() || s.jacobians > 0 || !(y.array() == y_settled.array()).all()))
-      ++settled_checks_failed_;
-    if (s.ok()) {
-      *q1 = y.template head<n>();
-      *p1 = y.template segment<n>(n);
-      *lambda = y.template tail<m>();
-    }
+    if (s.ok()) unpack(y, q1, p1, lambda);
     return s;
+  }
+
+  static void unpack(const Vec<double, Problem::ny>& y, VecN* q1, VecN* p1, VecM* lambda) {
+    *q1 = y.template head<n>();
+    *p1 = y.template segment<n>(n);
+    *lambda = y.template tail<m>();
   }
 
   // Fixed-point passes of the step's equations from y = (q1, p1, lambda), for
@@ -281,7 +313,9 @@ class DiscreteGradientStepper {
   // check, two passes a step on the particle instead of four (three curved,
   // one plain).  Measured side by side in a scratch run (particle, ns per
   // step, min of 15, before -> after): h = 0.2 320 -> 230, h = 0.05
-  // 343 -> 239, the triple jump at h = 0.2 1021 -> 698 (issue 13).
+  // 343 -> 239, the triple jump at h = 0.2 1021 -> 698 (issue 13).  Being
+  // exact from any input, that pass starts from z1 = z0 (map()), where c is
+  // 0 without an energy evaluation.
   //   Returns true (settled: the solve starts with the residual
   // check, NewtonSolver::solve) when a pass moves no component by more than
   // 4 eps of the terms it is made of, or stops contracting (by 1/2) within
@@ -326,20 +360,7 @@ class DiscreteGradientStepper {
     // many passes as the curved ones and the hand-over (measured on the
     // particle: h = 0.025, rho = 3e-4, the same 426 ns per step either way;
     // h = 0.0125: 371 ns plain, 438 curved; h = 0.05: 475 plain, 390 curved).
-    if (K_) {
-      curv_.at(h, [this](double hh) {
-        Curvature cv;
-        const Mat<double, n, n> hKM = (0.25 * hh * hh) * (*K_ * Minv_);
-        const Mat<double, n, n> G = Mat<double, n, n>::Identity() - hKM;
-        const double det = G.determinant();
-        if (hKM.cwiseAbs().maxCoeff() >= 5e-4 && std::isfinite(det) && std::abs(det) > 0.5) {  // (h^2/4) K small against M
-          cv.Q = G.inverse();
-          cv.MQ = Minv_ * cv.Q;
-          cv.ok = all_finite(cv.Q);
-        }
-        return cv;
-      });
-    }
+    if (K_) curvature(h);
     const bool curved = allow_curved && K_ && curv_.current().ok;
     const Mat<double, n, n>& Q = curv_.current().Q;
     const Mat<double, n, n>& MQ = curv_.current().MQ;
@@ -571,6 +592,23 @@ class DiscreteGradientStepper {
     bool ok = false;
   };
   mutable StepSizeCache<Curvature> curv_;  // current(): this step's
+  // Q and M^-1 Q for step size h, kept for the last two step sizes (K_
+  // set; passes()).
+  const Curvature& curvature(double h) const {
+    curv_.at(h, [this](double hh) {
+      Curvature cv;
+      const Mat<double, n, n> hKM = (0.25 * hh * hh) * (*K_ * Minv_);
+      const Mat<double, n, n> G = Mat<double, n, n>::Identity() - hKM;
+      const double det = G.determinant();
+      if (hKM.cwiseAbs().maxCoeff() >= 5e-4 && std::isfinite(det) && std::abs(det) > 0.5) {  // (h^2/4) K small against M
+        cv.Q = G.inverse();
+        cv.MQ = Minv_ * cv.Q;
+        cv.ok = all_finite(cv.Q);
+      }
+      return cv;
+    });
+    return curv_.current();
+  }
 };
 
 // The method table's entry (methods.hpp): "discrete_gradient", symmetric, so composable.

@@ -470,11 +470,15 @@ class DlaStepper {
   //   Except a potential of one coordinate r (dL/dq reads q_r alone, found by
   // autodiff at construction: the robot's V0 sin psi).  Then K = d(dL/dq)/dq
   // has one column, and every pass takes it at the nodes by a Jet of one
-  // derivative, linearizes dL/dq in q_next there, and solves with
-  // (M - u e_r^T)^-1 by Sherman-Morrison (u = h^2 sum_c w_c c (1 - c) K e_r):
+  // derivative, linearizes dL/dq in q_next there, and solves the linearized
+  // system (M - u e_r^T) v = ..., Omega v = 0 (u = h^2 sum_c w_c c (1 - c) K e_r):
   // a Newton step in the potential, so the passes converge quadratically, the
   // third is at round-off and the residual check confirms it (kNewtonPasses).
-  // Measured in one run at h = 0.2 on the robot (ns per step, before -> after):
+  // (Until 77a1b51 by Sherman-Morrison on (M - u e_r^T)^-1 and an m x m
+  // inverse after the curvature at every pass; since, through the constrained
+  // inverse Pi of M, taken only when Omega changes: run_passes.)
+  // Measured in one run at h = 0.2 on the robot, Sherman-Morrison form
+  // (ns per step, before -> after):
   // midpoint rule 525-552 -> 414-415 (Newton iterations 1.79 -> 0.007),
   // alpha = 1/4 521-580 -> 423-425, symmetric alpha = 1/4 721-742 -> 553-559.
   // (The same with the curvature of every coordinate, a Jet of n derivatives
@@ -618,7 +622,9 @@ class DlaStepper {
         // and (M - u e_r^T)^-1 = (I + z e_r^T / (1 - z_r)) M^-1, z = M^-1 u
         // (Sherman-Morrison), so a pass is a Newton step in the potential (with
         // the constraint nodes frozen).  Only while h^2 curvature is small against M
-        // (|1 - z_r| > 1/2, as for P), else the plain pass below.
+        // (|1 - z_r| > 1/2, as for P), else the plain pass below.  The pass
+        // itself solves through Pi (below); z is kept for that test and for
+        // polish(), which applies (M - u e_r^T)^-1 in this form.
         VecN z;
         double zs = 0;
         if constexpr (kNewton) {
@@ -660,8 +666,8 @@ class DlaStepper {
           // lambda = S0 Omega M^-1 x, S0 = (Omega M^-1 W^T)^-1,
           // Pi = M^-1 - M^-1 W^T S0 Omega M^-1; its row r gives
           // v_r = (Pi rhs')_r / (1 - (Pi u)_r).  The same system as the
-          // Sherman-Morrison form above, which took (Omega G W^T)^-1 after the
-          // curvature at every pass: measured side by side on the robot's
+          // Sherman-Morrison form (before 77a1b51), which took (Omega G W^T)^-1
+          // after the curvature at every pass: measured side by side on the robot's
           // midpoint rule at h = 0.2 (scratch loop, best of 40 x 10^5 steps,
           // four rounds) 299-305 -> 280-286 ns per step.
           if (!pi_ready || !(Om.array() == pi_Om.array()).all()) {
