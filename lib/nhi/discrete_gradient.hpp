@@ -159,7 +159,8 @@ class DiscreteGradientStepper {
   long passes_made() const { return passes_made_; }
   // Run the residual check on passes that settled by their move too (map();
   // off by default), and count: steps whose passes so settled, and of those,
-  // steps the check did not accept unchanged (tests/test_new_methods.cpp).
+  // steps the check did not accept unchanged (tests/test_new_methods.cpp;
+  // the second count only on a check_settled_passes(true) stepper).
   void check_settled_passes(bool on) { check_settled_ = on; }
   long settled_by_move_steps() const { return settled_by_move_steps_; }
   long settled_checks_failed() const { return settled_checks_failed_; }
@@ -198,15 +199,20 @@ class DiscreteGradientStepper {
     };
     // Except where the first pass is exact whatever its input (a quadratic
     // H, passes exact in the force, and a Gauss-Seidel first pass: the
-    // particle at h >= 0.05; passes()): the guess is then only the point
+    // particle at h >= 0.032; passes()): the guess is then only the point
     // at which that pass's frozen quantities are taken, and at z1 = z0
     // Gonzalez's correction is 0 with no energy to evaluate.  The passes
     // start from (q0, p0), and the explicit guess is made only if they do
-    // not settle, for Newton.  Measured side by side on the particle at
-    // h = 0.2 (scratch loop, min of 20 x 10^5 steps, three rounds):
-    // 140-143 -> 119-120 ns per step; the steps move by round-off (issue 13).
+    // not settle, for Newton (on the particle, at h = 0.4 to 10, they
+    // always settled or stalled at round-off: no step took that path in
+    // 1800 measured).  Measured side by side on the particle at h = 0.2:
+    // bench_steps, min of 5 interleaved rounds, 139.9 -> 125.7 ns per step
+    // (a scratch loop: 140-143 -> 119-120); the steps move by round-off
+    // (issue 13).  Where: the passes exact in the force (h^2/2 >= 5e-4 with
+    // the particle's default kx = ky = 1: h >= 0.032) and
+    // Curvature::first_pass_exact.
     bool trivial_start = false;
-    if constexpr (is_separable<S>::value) trivial_start = gs_ && curvature(h).ok;
+    if constexpr (is_separable<S>::value) trivial_start = gs_ && curvature(h).first_pass_exact;
     Vec<double, Problem::ny> y;
     if (trivial_start)
       y << q0, p0, *lambda;
@@ -248,9 +254,11 @@ class DiscreteGradientStepper {
       // passes, knows whether a residual meets it) (issue 13).
       // All of this sits under the separable branch, and the test's
       // bookkeeping (a copy of the iterate, a comparison) runs only on a
-      // check_settled_passes(true) stepper: with both on the common path,
-      // the non-separable contact_oscillator_nr, whose code path this never
-      // touches, measured +15 % per step (codegen).
+      // check_settled_passes(true) stepper.  With both on the common path
+      // 3ee564d's session measured +15 % per step on the non-separable
+      // contact_oscillator_nr, whose code path this never touches, and put
+      // it down to codegen; c9b6251's did not reproduce it on its host
+      // (README, "What made steps faster").
       if (settled && settled_by_move_) {
         ++settled_by_move_steps_;
         if (check_settled_) {
@@ -590,10 +598,18 @@ class DiscreteGradientStepper {
   struct Curvature {
     Mat<double, n, n> Q = Mat<double, n, n>::Zero(), MQ = Mat<double, n, n>::Zero();
     bool ok = false;
+    // The first pass is a Gauss-Seidel pass exact from any input (map()):
+    // gs_ says that M^-1 W^T misses the coordinates omega reads; M^-1 Q W^T
+    // does too where each such coordinate j has one entry in its row of
+    // M^-1, at column k, and its row of M^-1 Q none but there (then gs_
+    // makes W's column k zero, and with it (M^-1 Q W^T)_j).  A
+    // sufficient test, not a necessary one: a system it misses starts its
+    // passes from the explicit guess, as before.
+    bool first_pass_exact = false;
   };
   mutable StepSizeCache<Curvature> curv_;  // current(): this step's
   // Q and M^-1 Q for step size h, kept for the last two step sizes (K_
-  // set; passes()).
+  // set; passes() and map()).
   const Curvature& curvature(double h) const {
     curv_.at(h, [this](double hh) {
       Curvature cv;
@@ -604,6 +620,19 @@ class DiscreteGradientStepper {
         cv.Q = G.inverse();
         cv.MQ = Minv_ * cv.Q;
         cv.ok = all_finite(cv.Q);
+        if (cv.ok && gs_) {
+          cv.first_pass_exact = true;
+          for (int j = 0; j < n; ++j) {
+            if (!omega_reads_[j]) continue;
+            int k = -1, entries = 0;
+            for (int c = 0; c < n; ++c)
+              if (Minv_(j, c) != 0.0) ++entries, k = c;
+            bool only_k = entries == 1;
+            for (int c = 0; c < n && only_k; ++c)
+              if (c != k && cv.MQ(j, c) != 0.0) only_k = false;
+            cv.first_pass_exact = cv.first_pass_exact && only_k;
+          }
+        }
       }
       return cv;
     });
