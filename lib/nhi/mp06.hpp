@@ -315,6 +315,13 @@ class Mp06Stepper {
     steps_ = 0;
   }
 
+  // On a separable system Newton's only unknown is the multiplier (the
+  // explicit step, where it applies, needs no start at all), so the
+  // multiplier the next step starts from is its whole starting iterate: a
+  // composition sets it per stage (Composed, composition.hpp).
+  static constexpr bool starts_from_multiplier = kSeparable;
+  void guess_lambda(const VecM& l) { lambda_ = l; }
+
   // One step (q0, p0) -> (q1, p1) of size h; lambda holds the starting guess and gets the multiplier.
   StepSummary map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecM* lambda) const {
     StepSummary s;
