@@ -136,18 +136,11 @@ TEST(Mp06, CompositionStagesStartFromTheirOwnMultipliers) {
                 its_composed / 1000.0, its_chained / 1000.0, worst);
     EXPECT_LE(worst, 1e-12) << name;
     EXPECT_LT(its_composed, its_chained) << name;
+    // The triple jump's stages lock in: at most half the chained iterations.
+    if (std::string(name) == "triple_jump") {
+      EXPECT_LE(2 * its_composed, its_chained);
+    }
   }
-  // The triple jump's stages lock in: at most half the chained iterations.
-  Composed<Mp06Stepper<S>> tj(Mp06Stepper<S>(sys), composition("triple_jump"));
-  Mp06Stepper<S> chained(sys);
-  tj.start(S::default_q0(), S::default_v0());
-  chained.start(S::default_q0(), S::default_v0());
-  long a = 0, b = 0;
-  for (int k = 0; k < 1000; ++k) {
-    a += tj.step(0.2).iterations;
-    for (const double g : composition("triple_jump").gamma) b += chained.step(g * 0.2).iterations;
-  }
-  EXPECT_LE(2 * a, b);
 }
 
 // The velocity form's step is finished by the phase form's own equations

@@ -135,9 +135,12 @@ class Composed {
         if (remember) {
           // A stage that fails from its own multiplier is retried from the
           // previous stage's, the start it had before: at large h the last
-          // composed step's multiplier can be the farther one (on the sleigh,
-          // h >= 1.26, beyond every stable h, the triple jump's and order
-          // 6's runs failed earlier without the retry).
+          // composed step's multiplier can be the farther one.  A defensive
+          // fallback, not shown to pay: on the sleigh at h >= 1.26, beyond
+          // every largest stable h, which runs limp to T changed with the
+          // memory and did not change back with the retry (round-off decides
+          // there).  The inner stepper's failure messages count the retry as
+          // a step.
           const Vec<double, m> previous = inner_.lambda();
           inner_.guess_lambda(stage_lambda_[i]);
           s = inner_.step(c_.gamma[i] * h);
