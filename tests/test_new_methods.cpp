@@ -9,8 +9,10 @@
 // reversibility and bounded energies are in the typed contract suite
 // (test_methods.cpp), which runs these methods like every other.
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "../experiments/hand_steps.hpp"
 #include "scenes.hpp"
@@ -141,6 +143,104 @@ TEST(Mp06, CompositionStagesStartFromTheirOwnMultipliers) {
       EXPECT_LE(2 * its_composed, its_chained);
     }
   }
+}
+
+// The stage memory's retry, with a scripted inner stepper: it "solves" a
+// step in one iteration and leaves the next multiplier of its script, and
+// it fails (two iterations) when a step of the poisoned size starts from a
+// poisoned multiplier.  In the second composed step stage 2 (of size
+// gamma_2 h) starts from its own remembered multiplier, poisoned: it is
+// retried from stage 1's and succeeds, the two attempts' counts added.  In
+// the third, stage 2's memory and stage 1's multiplier are both poisoned:
+// the composed step fails, naming the stage, with every attempt counted; the
+// step after it does not start from the failed step's memory.
+struct ScriptedInner {
+  static constexpr int n = 1, m = 1, lag = 0;
+  static constexpr bool starts_from_multiplier = true;
+  struct Script {
+    std::vector<double> out;     // the multiplier each successful step leaves
+    std::vector<double> poison;  // starts that fail ...
+    double poisoned_h = 0;       // ... for a step of this size
+    std::vector<double> starts;  // the start of every attempt
+    size_t next = 0;
+  };
+  Script* script;
+  Vec<double, 1> lambda_ = Vec<double, 1>::Zero(), q_ = Vec<double, 1>::Zero();
+
+  MethodTraits traits() const { return MethodTraits{}; }
+  void start(const Vec<double, 1>& q0, const Vec<double, 1>&) {
+    q_ = q0;
+    lambda_.setZero();
+  }
+  const Vec<double, 1>& lambda() const { return lambda_; }
+  void guess_lambda(const Vec<double, 1>& l) { lambda_ = l; }
+  StepSummary step(double h) {
+    script->starts.push_back(lambda_[0]);
+    StepSummary s;
+    const auto& poison = script->poison;
+    if (h == script->poisoned_h && std::find(poison.begin(), poison.end(), lambda_[0]) != poison.end()) {
+      s.status = SolveStatus::kFailed;
+      s.failure = FailureKind::kSolve;
+      s.iterations = 2;
+      s.evaluations = 3;
+      s.message = "poisoned start";
+      return s;
+    }
+    s.status = SolveStatus::kConverged;
+    s.iterations = 1;
+    s.evaluations = 2;
+    lambda_[0] = script->out.at(script->next++);
+    q_[0] += h;
+    return s;
+  }
+  void sample(Sample<1, 1>*) const {}
+  Vec<double, 2> phase() const { return Vec<double, 2>(q_[0], 0.0); }
+};
+
+TEST(Composition, StageFailingFromItsMemoryIsRetriedFromThePreviousStage) {
+  const Composition& c = composition("triple_jump");
+  const double h = 0.25;
+  ScriptedInner::Script script;
+  script.poisoned_h = c.gamma[1] * h;
+  // Step 1's three stages; step 2's stage 1, stage 2's retry, stage 3; step
+  // 3's stage 1; step 4's three stages.
+  script.out = {10, 20, 30, 11, 21, 31, 12, 13, 23, 33};
+  script.poison = {20};
+  Composed<ScriptedInner> composed(ScriptedInner{&script}, c);
+  composed.start(Vec<double, 1>::Zero(), Vec<double, 1>::Zero());
+  using Starts = std::vector<double>;
+
+  // Step 1: no memory yet; each stage starts from the previous stage's multiplier.
+  StepSummary s = composed.step(h);
+  ASSERT_TRUE(s.ok()) << s.message;
+  EXPECT_EQ(s.iterations, 3);
+  EXPECT_EQ(script.starts, (Starts{0, 10, 20}));
+
+  // Step 2: stages start from their own multipliers, 10 20 30; stage 2's 20
+  // fails and is retried from stage 1's new 11.
+  s = composed.step(h);
+  ASSERT_TRUE(s.ok()) << s.message;
+  EXPECT_EQ(s.iterations, 1 + (2 + 1) + 1);
+  EXPECT_EQ(s.evaluations, 2 + (3 + 2) + 2);
+  EXPECT_EQ(script.starts, (Starts{0, 10, 20, 10, 20, 11, 30}));
+  EXPECT_NEAR(composed.phase()[0], 2 * h, 1e-15);
+
+  // Step 3: stage 1 leaves 12; stage 2 from its own 21 and from 12, both poisoned.
+  script.poison = {21, 12};
+  s = composed.step(h);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.failure, FailureKind::kSolve);
+  EXPECT_EQ(s.iterations, 1 + (2 + 2));
+  EXPECT_NE(s.message.find("triple_jump stage 2 of 3: poisoned start"), std::string::npos) << s.message;
+  EXPECT_EQ(script.starts, (Starts{0, 10, 20, 10, 20, 11, 30, 11, 21, 12}));
+
+  // Step 4: the failed step left no memory: the stages chain from the inner
+  // stepper's multiplier (12, its last start) as in step 1; with memory
+  // stage 2 would have started from its remembered one.
+  script.poison.clear();
+  s = composed.step(h);
+  ASSERT_TRUE(s.ok()) << s.message;
+  EXPECT_EQ(script.starts, (Starts{0, 10, 20, 10, 20, 11, 30, 11, 21, 12, 12, 13, 23}));
 }
 
 // The velocity form's step is finished by the phase form's own equations
