@@ -153,7 +153,8 @@ TEST(Mp06, CompositionStagesStartFromTheirOwnMultipliers) {
 // retried from stage 1's and succeeds, the two attempts' counts added.  In
 // the third, stage 2's memory and stage 1's multiplier are both poisoned:
 // the composed step fails, naming the stage, with every attempt counted; the
-// step after it does not start from the failed step's memory.
+// step after it does not start from the failed step's memory, nor does a
+// step of the other sign of h (the step after that does, from its own).
 struct ScriptedInner {
   static constexpr int n = 1, m = 1, lag = 0;
   static constexpr bool starts_from_multiplier = true;
@@ -183,12 +184,15 @@ struct ScriptedInner {
       s.failure = FailureKind::kSolve;
       s.iterations = 2;
       s.evaluations = 3;
+      s.jacobians = 1;
+      s.rhs_evaluations = 5;
       s.message = "poisoned start";
       return s;
     }
     s.status = SolveStatus::kConverged;
     s.iterations = 1;
     s.evaluations = 2;
+    s.rhs_evaluations = 1;
     lambda_[0] = script->out.at(script->next++);
     q_[0] += h;
     return s;
@@ -203,8 +207,8 @@ TEST(Composition, StageFailingFromItsMemoryIsRetriedFromThePreviousStage) {
   ScriptedInner::Script script;
   script.poisoned_h = c.gamma[1] * h;
   // Step 1's three stages; step 2's stage 1, stage 2's retry, stage 3; step
-  // 3's stage 1; step 4's three stages.
-  script.out = {10, 20, 30, 11, 21, 31, 12, 13, 23, 33};
+  // 3's stage 1; steps 4, 5 and 6's three stages each.
+  script.out = {10, 20, 30, 11, 21, 31, 12, 13, 23, 33, 14, 24, 34, 15, 25, 35};
   script.poison = {20};
   Composed<ScriptedInner> composed(ScriptedInner{&script}, c);
   composed.start(Vec<double, 1>::Zero(), Vec<double, 1>::Zero());
@@ -222,6 +226,8 @@ TEST(Composition, StageFailingFromItsMemoryIsRetriedFromThePreviousStage) {
   ASSERT_TRUE(s.ok()) << s.message;
   EXPECT_EQ(s.iterations, 1 + (2 + 1) + 1);
   EXPECT_EQ(s.evaluations, 2 + (3 + 2) + 2);
+  EXPECT_EQ(s.jacobians, 0 + (1 + 0) + 0);
+  EXPECT_EQ(s.rhs_evaluations, 1 + (5 + 1) + 1);
   EXPECT_EQ(script.starts, (Starts{0, 10, 20, 10, 20, 11, 30}));
   EXPECT_NEAR(composed.phase()[0], 2 * h, 1e-15);
 
@@ -231,6 +237,8 @@ TEST(Composition, StageFailingFromItsMemoryIsRetriedFromThePreviousStage) {
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.failure, FailureKind::kSolve);
   EXPECT_EQ(s.iterations, 1 + (2 + 2));
+  EXPECT_EQ(s.evaluations, 2 + (3 + 3));
+  EXPECT_EQ(s.jacobians, 0 + (1 + 1));
   EXPECT_NE(s.message.find("triple_jump stage 2 of 3: poisoned start"), std::string::npos) << s.message;
   EXPECT_EQ(script.starts, (Starts{0, 10, 20, 10, 20, 11, 30, 11, 21, 12}));
 
@@ -241,6 +249,14 @@ TEST(Composition, StageFailingFromItsMemoryIsRetriedFromThePreviousStage) {
   s = composed.step(h);
   ASSERT_TRUE(s.ok()) << s.message;
   EXPECT_EQ(script.starts, (Starts{0, 10, 20, 10, 20, 11, 30, 11, 21, 12, 12, 13, 23}));
+
+  // Step 5, of -h: no memory across the change of sign (stage 1 would start
+  // from its 13, stage 2 from its 23); step 6, of -h again, from its own.
+  s = composed.step(-h);
+  ASSERT_TRUE(s.ok()) << s.message;
+  s = composed.step(-h);
+  ASSERT_TRUE(s.ok()) << s.message;
+  EXPECT_EQ(Starts(script.starts.begin() + 13, script.starts.end()), (Starts{33, 14, 24, 14, 24, 34}));
 }
 
 // The velocity form's step is finished by the phase form's own equations

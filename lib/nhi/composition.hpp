@@ -124,14 +124,15 @@ class Composed {
     h_last_ = 0;
   }
 
-  // Written so that a stage pays for the memory only its two copies of the
+  // Written so that a stage pays for the memory only its copies of the
   // multiplier: the retry out of line, each stage's summary constructed in
-  // place.  61ee5ff's form (a default summary move-assigned from the step,
+  // place.  4dc76ca's form (a default summary move-assigned from the step,
   // the retry inline) cost up to a sixth of a composed step where the inner
   // step is cheap and needs no memory (scratch, min of 5 x 2x10^5 steps, h =
-  // 0.2: the particle's triple jump 73 -> 86 ns, the contact oscillator's
-  // 69 -> 78, the robot's 247 -> 262; bench_steps side by side in the
-  // README, "What made steps faster").
+  // 0.2, the composed step before 61ee5ff's memory against 4dc76ca's: the
+  // particle's triple jump 73 -> 86 ns, the contact oscillator's 69 -> 78,
+  // the robot's 247 -> 262; bench_steps side by side in the README, "What
+  // made steps faster").
   StepSummary step(double h) {
     StepSummary total;
     // Stage memory (above): the last composed step was one of h's sign.
