@@ -124,8 +124,8 @@ class Composed {
     h_last_ = 0;
   }
 
-  // Written so that a stage pays for the memory only its copies of the
-  // multiplier: the retry out of line, each stage's summary constructed in
+  // Written so that a stage pays for the memory only two copies of the
+  // multiplier (its start and its result): the retry out of line, each stage's summary constructed in
   // place.  4dc76ca's form (a default summary move-assigned from the step,
   // the retry inline) cost up to a sixth of a composed step where the inner
   // step is cheap and needs no memory (scratch, min of 5 x 2x10^5 steps, h =
@@ -142,16 +142,14 @@ class Composed {
       h_last_ = 0;  // (set again once this step has succeeded)
     }
     for (size_t i = 0; i < c_.gamma.size(); ++i) {
-      [[maybe_unused]] Vec<double, m> previous;
       if constexpr (kStageMemory) {
-        if (remember) {
-          previous = inner_.lambda();
-          inner_.guess_lambda(stage_lambda_[i]);
-        }
+        if (remember) inner_.guess_lambda(stage_lambda_[i]);
       }
       StepSummary s = inner_.step(c_.gamma[i] * h);
       if constexpr (kStageMemory) {
-        if (remember && !s.ok()) retry(c_.gamma[i] * h, previous, &s);
+        // The previous stage's multiplier (the last stage's of the last
+        // composed step, for the first) is the one the memory holds for it.
+        if (remember && !s.ok()) retry(c_.gamma[i] * h, stage_lambda_[i == 0 ? c_.gamma.size() - 1 : i - 1], &s);
         stage_lambda_[i] = inner_.lambda();
       }
       total.iterations += s.iterations;
