@@ -244,6 +244,33 @@ struct Mp06SeparableProblem {
     const Mat<T, m, n> W1 = sys.template omega<T>(q1);
     mp06_constraint_rows(W1, v1, 0, r, terms);  // omega(q1) V(q1, p1) = 0
   }
+
+  // The rounding of q1 (NewtonSolver's rounding_terms, solver.hpp): row a
+  // gets sum_k |d(omega_a(q1) v1)/dq1_k| |q1_k|, by one Jet evaluation of
+  // omega.  q1 = q_half + (h/2) V(p1) carries a relative eps of its own that
+  // its derivative in lambda, of size h^2 |M^-1 omega^T|, does not show: on
+  // the sleigh running straight at theta ~ 3.09, sin(theta) ~ 0.05 takes
+  // theta's last bit (~4e-16) as a relative error of ~1e-14 while the row's
+  // two terms (0.086 each) cancel, and a start from the last multiplier sat
+  // at 20 eps of the terms, above newton()'s 16 eps: one iteration a stage
+  // that could not improve it (Suzuki 5's stages 4 and 5; issue 13).  The
+  // rounding of p1 is left out: V is linear in p, so it is that of v1, which
+  // the terms |omega_aj v1_j| already are.
+  void rounding_terms(const Vec<double, ny>& lambda, const Vec<double, nl>&, Vec<double, ny + nl>* extra) const {
+    VecN q1, p1, v1;
+    state<double>(lambda, &q1, &p1, &v1);
+    using J = ceres::Jet<double, n>;
+    Vec<J, n> qj;
+    for (int k = 0; k < n; ++k) qj[k] = J(q1[k], k);
+    const Mat<J, m, n> W1 = sys.template omega<J>(qj);
+    for (int a = 0; a < m; ++a) {
+      J c = J(0.0);
+      for (int j = 0; j < n; ++j) c += W1(a, j) * v1[j];
+      double e = 0;
+      for (int k = 0; k < n; ++k) e += std::abs(c.v[k]) * std::abs(q1[k]);
+      (*extra)[a] = e;
+    }
+  }
 };
 
 // The stateful mp06 stepper (stepper.hpp), lag 0.  kSeparable selects the

@@ -21,6 +21,16 @@
 // relative residual of row i is |r_i| / (terms_i + sum_j |dr_i/dy_j| y_scale_j):
 // the second part is the residual a unit relative change of y causes, so the
 // floor it sets is the round-off of y itself (e.g. in (q1 - q0)/h when |q| is large).
+// A Problem whose residual reads quantities it computes from y (mp06's
+// separable form: q1 = q_half + (h/2) V(p1(lambda))) may also provide
+//   void rounding_terms(const Vec<double,ny>& y, const Vec<double,nl>& lambda,
+//                       Vec<double,ny+nl>* extra) const;
+// extra_i = sum_k |dr_i/du_k| |u_k| over those quantities u: the residual
+// their own rounding (a relative eps each, like y's) can cause, which the
+// derivatives in y do not show when u is much larger than its change with y.
+// It is part of the scale (evaluate()); newton() computes it only when it
+// can decide, for a residual within tolerance but above 16 eps of the scale
+// without it (has_rounding_terms below).
 #pragma once
 
 #include <ceres/tiny_solver.h>
@@ -31,10 +41,20 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 #include "nhi/stepper.hpp"
 
 namespace nhi {
+
+// Does the Problem provide rounding_terms() (above)?
+template <class P, class = void>
+struct has_rounding_terms : std::false_type {};
+template <class P>
+struct has_rounding_terms<P, std::void_t<decltype(std::declval<const P&>().rounding_terms(
+                                 std::declval<const Vec<double, P::ny>&>(), std::declval<const Vec<double, P::nl>&>(),
+                                 std::declval<Vec<double, P::ny + P::nl>*>()))>> : std::true_type {};
 
 struct SolverOptions {
   double tolerance = 1e-12;  // required relative residual
@@ -103,7 +123,7 @@ class NewtonSolver {
   double relative_residual(const VecY& y, const VecL& lambda, VecX* r_out = nullptr) const {
     VecX r;
     Mat<double, N, ny> Jy;
-    const double rel = evaluate(y, lambda, &r, &Jy);
+    const double rel = evaluate(y, lambda, &r, &Jy, nullptr, true);
     if (r_out) *r_out = r;
     return rel;
   }
@@ -117,9 +137,10 @@ class NewtonSolver {
 
   // Residual and its y-Jacobian by one Jet evaluation; returns the relative residual.
   // *scale_out (optional) gets the whole scale of each row at y: the terms of
-  // the residual plus sum_j |dr_i/dy_j| y_scale_j.
-  double evaluate(const VecY& y, const VecL& lambda, VecX* r, Mat<double, N, ny>* Jy,
-                  VecX* scale_out = nullptr) const {
+  // the residual plus sum_j |dr_i/dy_j| y_scale_j, plus the rounding terms
+  // (has_rounding_terms) when with_rounding.
+  double evaluate(const VecY& y, const VecL& lambda, VecX* r, Mat<double, N, ny>* Jy, VecX* scale_out = nullptr,
+                  bool with_rounding = false) const {
     using J = ceres::Jet<double, ny>;
     Vec<J, ny> yj;
     for (int i = 0; i < ny; ++i) yj[i] = J(y[i], i);
@@ -128,6 +149,13 @@ class NewtonSolver {
     VecX terms;
     p_.template residual<J>(yj, lj, &rj, &terms);
     const VecY ys = p_.y_scale(y);
+    if constexpr (has_rounding_terms<P>::value) {
+      if (with_rounding) {
+        VecX extra;
+        p_.rounding_terms(y, lambda, &extra);
+        terms += extra;
+      }
+    }
     double rel = 0;
     for (int i = 0; i < N; ++i) {
       (*r)[i] = rj[i].a;
@@ -314,12 +342,30 @@ class NewtonSolver {
     double rel = evaluate(y, lambda, &r, &Jy, &scale);
     ++s.evaluations;
     ++s.jacobians;
+    bool rounded = false;  // the rounding terms are in scale
     for (int it = 0;; ++it) {
       s.relative_residual = rel;
       if (!std::isfinite(rel)) {
         s.message = "non-finite residual";
         s.failure = FailureKind::kNonFinite;
         return s;
+      }
+      // The rounding terms (has_rounding_terms), where they can decide: they
+      // only grow the scale, so a residual above tolerance without them is
+      // not accepted (stricter than the whole scale, where |u| >> 1e-12 / eps
+      // of the terms), and one at 16 eps does not need them.  Evaluated at the
+      // iterate, counted as an evaluation.
+      if constexpr (has_rounding_terms<P>::value) {
+        if (!rounded && rel <= options_.tolerance && !(rel <= kRoundoff)) {
+          VecX extra;
+          p_.rounding_terms(y, lambda, &extra);
+          ++s.evaluations;
+          scale += extra;
+          rounded = true;
+          rel = 0;
+          for (int i = 0; i < N; ++i) rel = std::max(rel, ratio(r[i], scale[i]));
+          s.relative_residual = rel;
+        }
       }
       if (rel <= options_.tolerance && (rel <= kRoundoff || rel > 0.5 * prev)) {
         if (it == 0) {  // the start's own update (above)
@@ -358,6 +404,7 @@ class NewtonSolver {
         ++s.evaluations;
         ++s.jacobians;
         fresh = true;
+        rounded = false;
       }
     }
     *y_io = y;
@@ -404,7 +451,7 @@ class NewtonSolver {
     const VecL lambda = x.template tail<nl>();
     VecX r;
     Mat<double, N, ny> Jy;
-    s.relative_residual = evaluate(y, lambda, &r, &Jy);
+    s.relative_residual = evaluate(y, lambda, &r, &Jy, nullptr, true);
     if (std::isfinite(s.relative_residual) && s.relative_residual <= options_.tolerance) {
       *y_io = y;
       *lambda_io = lambda;
