@@ -335,7 +335,7 @@ TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
 // offsets smooth from step to step: mean corrections of 0.94 (contact
 // oscillator, midpoint rule, h = 0.4 / 2^8), 2.0 (chaotic oscillator) and 1.03
 // (sleigh, h = 0.4 / 2^9) eps |q|_inf, and a drift of the mean energy error
-// (README, issue 13); with the correction at most 0.18.  *accepted_share
+// (experiments/speed_log.md, "Kept accurate"); with the correction at most 0.18.  *accepted_share
 // gets the share of steps the check accepted, so that the assertion is not
 // empty where it matters: at small h the passes of a separable scene reach
 // the check on at least 79 % of the steps (measured), asserted 50 %.

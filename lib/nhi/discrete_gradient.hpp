@@ -244,7 +244,7 @@ class DiscreteGradientStepper {
       // tests/test_new_methods.cpp, SeparableTest.DiscreteGradientSettledPassesNeedNoCheck).
       // Not every one everywhere: over the 10^6 composed steps of the long-horizon
       // study the contact oscillator's discrete gradient + triple jump and
-      // + order 6 moved by round-off without it (README, "What moved").
+      // + order 6 moved by round-off without it (experiments/speed_log.md, "What moved").
       // Measured side by side at h = 0.2 (bench_steps, min of 3 interleaved
       // rounds): particle 182.6 -> 151.1 ns, contact oscillator 397 -> 353,
       // robot 1402 -> 1338.  A step so accepted reports no evaluation and relative_residual 0
@@ -258,7 +258,7 @@ class DiscreteGradientStepper {
       // 3ee564d's session measured +15 % per step on the non-separable
       // contact_oscillator_nr, whose code path this never touches, and put
       // it down to codegen; c9b6251's did not reproduce it on its host
-      // (README, "What made steps faster").
+      // (experiments/speed_log.md, "What made steps faster").
       if (settled && settled_by_move_) {
         ++settled_by_move_steps_;
         if (check_settled_) {

@@ -273,7 +273,7 @@ class DlaStepper {
   // where the first pass is exact, gs_) and goes straight to the check (the
   // check, not a further pass, confirms it); otherwise it makes kMinPasses,
   // or kMaxPasses on every 8th step to find out, and is checked only if a
-  // pass moved nothing (issue 13; measured in the README).
+  // pass moved nothing (issue 13; measured in experiments/speed_log.md).
   static constexpr int kMaxPasses = 4, kMinPasses = 2;
   // Passes that take the curvature of a potential of one coordinate (next_guess)
   // converge quadratically: from the extrapolation the third is at round-off
@@ -643,7 +643,7 @@ class DlaStepper {
           // with kappa = 0 the stepper makes one pass before the residual
           // check (gs_, step()).  Kept to kappa = 0: on every plain pass it
           // made the contact oscillator's midpoint DLA slower (the
-          // measurements: README, "What made steps faster", d67faed/525ba90).
+          // measurements: experiments/speed_log.md, "What made steps faster", d67faed/525ba90).
           vfree = velocity<S, double>(sys, qbar, rhs);
           for (int i = 0; i < n; ++i)
             if ((VWt.row(i).array() == 0.0).all()) (*q_guess)[i] = q[i] + h * vfree[i];

@@ -74,8 +74,8 @@ struct Particle {
     // (-y, 0) is written as one pair, (-y) (1, 0), not entry by entry: Eigen
     // reads the row's first two entries as one 16-byte packet, and after two
     // 8-byte stores that load missed the CPU's store-to-load forwarding and
-    // stalled (perf: a third of mp06's particle step, issue 13; README,
-    // "Tried and dropped").  The same values for finite y (w[1] = -0 for y > 0),
+    // stalled (perf: a third of mp06's particle step, issue 13;
+    // experiments/speed_log.md, "Tried and dropped").  The same values for finite y (w[1] = -0 for y > 0),
     // and every step of the particle bit for bit the same.
     Mat<T, 1, 3> w;
     w.template head<2>() = Mat<T, 1, 2>::Constant(-q[1]).cwiseProduct(Mat<T, 1, 2>(cst<T>(1.0), cst<T>(0.0)));
