@@ -91,8 +91,9 @@ struct starts_from_multiplier<Inner, std::void_t<decltype(Inner::starts_from_mul
 // Since the solver's rounding terms (solver.hpp, mp06.hpp) starts from the
 // previous stage lock in too (no Newton iteration after ~180 composed
 // steps), and with slightly fewer iterations; the memory still saves
-// residual evaluations (its starts need the rounding terms less often) and
-// time: scratch, min of 5 x 2x10^5 steps at h = 0.2 restarted every 10^3,
+// residual evaluations on the triple jump and order 6 (its starts need the
+// rounding terms less often; not on Suzuki 5, 9.13 against 8.71 a composed
+// step over 10^3) and time on all three: scratch, min of 5 x 2x10^5 steps at h = 0.2 restarted every 10^3,
 // with the memory against without, triple jump 184 against 221 ns, Suzuki
 // 5 351 against 369, order 6 582-602 against 677-685.
 template <class Inner>

@@ -25,12 +25,15 @@
 // separable form: q1 = q_half + (h/2) V(p1(lambda))) may also provide
 //   void rounding_terms(const Vec<double,ny>& y, const Vec<double,nl>& lambda,
 //                       Vec<double,ny+nl>* extra) const;
-// extra_i = sum_k |dr_i/du_k| |u_k| over those quantities u: the residual
-// their own rounding (a relative eps each, like y's) can cause, which the
-// derivatives in y do not show when u is much larger than its change with y.
-// It is part of the scale (evaluate()); newton() computes it only when it
-// can decide, for a residual within tolerance but above 16 eps of the scale
-// without it (has_rounding_terms below).
+// extra_i = sum_k |dr_i/du_k| |u_k| over those quantities u that move with
+// y: the residual their own rounding (a relative eps each, like y's) can
+// cause, which the derivatives in y do not show when u is much larger than
+// its change with y.  (A quantity that does not move with y is a fixed input
+// of the solve, whose rounding Newton solves around: not counted.)  It is
+// part of the scale of relative_residual() and of the fallback's final
+// check; newton() computes it only for a residual within tolerance but above
+// 16 eps of the scale without it, where it decides between accepting and
+// iterating (has_rounding_terms below).
 #pragma once
 
 #include <ceres/tiny_solver.h>
@@ -119,7 +122,8 @@ class NewtonSolver {
     return s;
   }
 
-  // Relative residual at (y, lambda); *r_out gets the residual.
+  // Relative residual at (y, lambda), its scale with the rounding terms
+  // (has_rounding_terms); *r_out gets the residual.
   double relative_residual(const VecY& y, const VecL& lambda, VecX* r_out = nullptr) const {
     VecX r;
     Mat<double, N, ny> Jy;
