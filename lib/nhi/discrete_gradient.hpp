@@ -227,12 +227,20 @@ class DiscreteGradientStepper {
     bool settled = false;
     if constexpr (is_separable<S>::value) {
       settled_by_move_ = false;
-      Vec<double, Problem::ny> yp = y;
-      settled = passes(prob, &yp);
-      if (settled)
-        y = yp;
-      else if (trivial_start)
-        y = explicit_guess();
+      // The passes work on y itself, and a step they do not settle makes
+      // the explicit guess again for Newton (the same values: a function of
+      // q0, p0 and *lambda alone).  A copy of y for them, kept in case they
+      // failed, cost a sixth of the particle's step: perf put 17 % of it in
+      // map(), mostly at that copy and at the unpacking after it, loads of
+      // 16 bytes from y just written by 8-byte stores (the store-to-load
+      // forwarding stall of particle.hpp's omega, "Tried and dropped" in
+      // experiments/speed_log.md).  Scratch, min of 3 x 10^6 steps at
+      // h = 0.2 restarted every 10^3: particle 116 -> 95-100 ns, its triple
+      // jump 360-371 -> 288-301, contact oscillator 310-323 -> 299-310, the
+      // other scenes the same to the noise; every step bit for bit the same
+      // (issue 13).
+      settled = passes(prob, &y);
+      if (!settled) y = explicit_guess();
       // Passes that ended on a plain pass settled by its move (no component
       // moved by more than 4 eps of the terms of its residual row) are a fixed
       // point of the step's equations to their rounding: the plain pass solves
