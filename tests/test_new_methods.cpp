@@ -467,7 +467,7 @@ TYPED_TEST(SeparableTest, Mp06RoundingTermsAreTheResidualsResponseToQ1) {
     Vec<J, n> q1j, p1j, v1j;
     prob.template state<J>(lj, &q1j, &p1j, &v1j);
     if (Mp06Stepper<S>::explicit_structure(rs)) EXPECT_TRUE((extra.array() == 0.0).all()) << S::name << " trial " << trial;
-    Vec<double, m> fd = Vec<double, m>::Zero(), size = Vec<double, m>::Zero();
+    Vec<double, m> fd = Vec<double, m>::Zero();
     for (int k = 0; k < n; ++k) {
       if ((q1j[k].v.array() == 0.0).all()) continue;  // a coordinate lambda does not move
       const double d = std::ldexp(1.0, -26) * std::max(std::abs(q1[k]), 1e-3);
@@ -477,7 +477,7 @@ TYPED_TEST(SeparableTest, Mp06RoundingTermsAreTheResidualsResponseToQ1) {
       const Vec<double, m> dr = (rs.template omega<double>(qp) - rs.template omega<double>(qm)) * v1 / (2 * d);
       fd += dr.cwiseAbs() * std::abs(q1[k]);
     }
-    size = rs.template omega<double>(q1).cwiseAbs() * v1.cwiseAbs();
+    const Vec<double, m> size = rs.template omega<double>(q1).cwiseAbs() * v1.cwiseAbs();
     for (int a = 0; a < m; ++a) {
       const double err = std::abs(extra[a] - fd[a]) / (extra[a] + size[a] + kEps);
       worst = std::max(worst, err);

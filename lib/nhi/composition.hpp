@@ -88,14 +88,15 @@ struct starts_from_multiplier<Inner, std::void_t<decltype(Inner::starts_from_mul
 // steps in 3ee564d's session, 2.75-2.99 iterations a step; written
 // 2 lambda_1 - lambda_2 it did, 0.23 in the third block: which of them
 // locks in depends on single roundings, the plain memory did here.)
-// Since the solver's rounding terms (solver.hpp, mp06.hpp) starts from the
-// previous stage lock in too (no Newton iteration after ~180 composed
-// steps), and with slightly fewer iterations; the memory still saves
-// residual evaluations on the triple jump and order 6 (its starts need the
-// rounding terms less often; not on Suzuki 5, 9.13 against 8.71 a composed
-// step over 10^3) and time on all three: scratch, min of 5 x 2x10^5 steps at h = 0.2 restarted every 10^3,
-// with the memory against without, triple jump 184 against 221 ns, Suzuki
-// 5 351 against 369, order 6 582-602 against 677-685.
+// With the solver's rounding terms (solver.hpp, mp06.hpp), stages started
+// from the previous stage's multiplier lock in too (no Newton iteration
+// after ~180 composed steps), with slightly fewer iterations than the
+// memory's.  The memory still saves residual evaluations on the triple jump
+// and order 6 (its starts need the rounding terms less often; not on Suzuki
+// 5: 9.13 against 8.71 a composed step over 10^3) and time on all three:
+// scratch, min of 5 x 2x10^5 steps at h = 0.2 restarted every 10^3, with
+// the memory against without, triple jump 184 against 221 ns, Suzuki 5 351
+// against 369, order 6 582-602 against 677-685.
 template <class Inner>
 class Composed {
  public:
@@ -133,8 +134,8 @@ class Composed {
   }
 
   // Written so that a stage pays for the memory only two copies of the
-  // multiplier (its start and its result): the retry out of line, each stage's summary constructed in
-  // place.  4dc76ca's form (a default summary move-assigned from the step,
+  // multiplier (its start and its result): the retry out of line, each
+  // stage's summary constructed in place.  4dc76ca's form (a default summary move-assigned from the step,
   // the retry inline) cost up to a sixth of a composed step where the inner
   // step is cheap and needs no memory (scratch, min of 5 x 2x10^5 steps, h =
   // 0.2, the composed step before 61ee5ff's memory against 4dc76ca's: the

@@ -247,24 +247,24 @@ struct Mp06SeparableProblem {
   }
 
   // The rounding of q1 (NewtonSolver's rounding_terms, solver.hpp): row a
-  // gets sum_k |d(omega_a(q1) v1)/dq1_k| |q1_k| over the coordinates the
-  // multiplier moves (V(h omega(q_half)^T e_a)_k != 0 for some a), by one
-  // Jet evaluation of omega.  A coordinate it does not move is a fixed
-  // input of the solve, like q_half, whose rounding Newton can solve
-  // around: counting it would accept residuals far from round-off (a
-  // review's scratch system, omega reading a coordinate of size 6e6 that
-  // the force does not move: accepted at 16000 eps of the terms against 55
-  // without).  Where the step is explicit no coordinate counts (zero).  q1 = q_half + (h/2) V(p1) carries a relative eps of its own that
+  // gets sum_k |d(omega_a(q1) v1)/dq1_k| |q1_k|, by one Jet evaluation of
+  // omega.  q1 = q_half + (h/2) V(p1) carries a relative eps of its own that
   // its derivative in lambda, of size h^2 |M^-1 omega^T|, does not show: on
   // the sleigh running straight at theta ~ 3.09, sin(theta) ~ 0.05 takes
   // theta's last bit (~4e-16) as a relative error of ~1e-14 while the row's
   // two terms (0.087 each) cancel, and a start from the last multiplier sat
   // at 20 eps of the terms, above newton()'s 16 eps: one iteration a stage
-  // that could not improve it (Suzuki 5's stages 4 and 5; issue 13).  The
-  // rounding of p1 is left out: V is linear in p, so with a diagonal M^-1 it
-  // is that of v1, which the terms |omega_aj v1_j| already are (with a
-  // non-diagonal one it is not covered: the test is then stricter, not
-  // looser).
+  // that could not improve it (Suzuki 5's stages 4 and 5; issue 13).
+  //   Only the coordinates the multiplier moves count (V(h omega(q_half)^T
+  // e_a)_k != 0 for some a): one it does not move is a fixed input of the
+  // solve, like q_half, whose rounding Newton can solve around, and counting
+  // it would accept residuals far from round-off (a review's scratch system,
+  // omega reading such a coordinate of size 6e6: accepted at 16000 eps of
+  // the terms against 55 without).  Where the step is explicit none counts.
+  //   The rounding of p1 is left out: V is linear in p, so with a diagonal
+  // M^-1 it is that of v1, which the terms |omega_aj v1_j| already are
+  // (with a non-diagonal one it is not covered: the test is then stricter,
+  // not looser).
   void rounding_terms(const Vec<double, ny>& lambda, const Vec<double, nl>&, Vec<double, ny + nl>* extra) const {
     extra->setZero();
     std::array<bool, n> moved{};
