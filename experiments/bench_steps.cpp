@@ -35,10 +35,10 @@ constexpr int kStates = 256;
 
 // Steps of a library method from the system's default state, restarted every
 // 10^3 steps to stay on a bounded stretch of trajectory.  The method is chosen
-// by name once, outside the timed loop.  (It was 10^4: the sleigh's angular
-// velocity decays exponentially, by 1e-75 every 200 time units from its
-// default state, and is subnormal from t ~ 800, step ~4000 at h = 0.2, after
-// which an RK4 step measured 1-5 us instead of 84 ns.)
+// by name once, outside the timed loop.  (The sleigh's angular velocity
+// decays exponentially, by 1e-75 every 200 time units from its default
+// state, and is subnormal from t ~ 800, step ~4000 at h = 0.2, after which
+// subnormal arithmetic makes every step many times slower.)
 template <class S>
 void BM_Method(benchmark::State& state, nhi::MethodSpec spec) {
   const S sys;
@@ -170,7 +170,7 @@ void BM_AnalyticFloor(benchmark::State& state) {
 
 // The floor for mp06 on contact_oscillator_nr: the step reduced by hand to one
 // scalar equation solved by Newton (experiments/hand_steps.hpp; the same map as the
-// library's to round-off, tests/test_new_methods.cpp), on the same trajectory
+// library's to round-off, tests/test_mp06.cpp), on the same trajectory
 // as BM_Method's rows: from the default state, restarted every 10^3 steps.
 void BM_Mp06NrFloor(benchmark::State& state) {
   const nhi::ContactOscillatorNR sys;
@@ -372,8 +372,7 @@ int main(int argc, char** argv) {
   // With --benchmark_repetitions=N (make reproduce: 3, randomly interleaved,
   // so that a slow spell of the machine falls on one repetition of a row, not
   // on all of it), each row is the repetition with the least CPU time (the
-  // machine's noise only adds: in one run the robot's RK4 step read 117, 200
-  // and 201 ns), and cpu_ns_repetitions lists all of them.
+  // machine's noise only adds), and cpu_ns_repetitions lists all of them.
   std::vector<std::string> order;
   std::map<std::string, std::vector<nhi::json>> by_name;
   for (const auto& r : rep.rows) {

@@ -1,7 +1,7 @@
 // Hand-reduced steps: one method on one scene, written out by hand with every
 // structure of that scene used, as a floor for what the library's generic
 // solve of the same equations could cost (bench_steps measures both in one
-// run; tests/test_new_methods.cpp checks that they are the same map to
+// run; tests/test_mp06.cpp checks that they are the same map to
 // round-off).  Not library code: nothing here is generic.
 #pragma once
 
@@ -25,14 +25,13 @@ namespace floors {
 // equation in w:
 //   g(w) = (w + sin(z_half + h w / 2)) (1 - (h/2) cos z_half) - bz + y_half (y1 w + bx) = 0,
 // solved by Newton with g' written out: one sin and one cos per iteration.
-// The start is the zero of g linearized at w = 0 (no new sin or cos; starting
-// instead from the momentum equation with the last multiplier left the first
-// Newton update at ~10 % of w: 2.99 iterations a step on bench_steps'
-// trajectory, this start 2.33).  The iteration stops when the Newton update is
-// below 1e-9 relative, after which the error is of the order of its square (no
-// residual is evaluated to confirm it, which the library's solve does): a
-// floor, not a robust solver.  step() returns false if 20 iterations did not
-// get there.
+// The start is the zero of g linearized at w = 0 (no new sin or cos; a start
+// from the momentum equation with the last multiplier leaves the first
+// Newton update at ~10 % of w, and takes more iterations).  The iteration
+// stops when the Newton update is below 1e-9 relative, after which the error
+// is of the order of its square (no residual is evaluated to confirm it,
+// which the library's solve does): a floor, not a robust solver.  step()
+// returns false if 20 iterations did not get there.
 struct Mp06ContactOscillatorNR {
   double epsilon = 0.3;
   long iterations = 0;  // summed over steps

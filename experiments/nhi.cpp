@@ -1,5 +1,6 @@
-// nhi: run one scene.
+// nhi: run one scene, or list what the library has.
 //   nhi run SCENE.json [--set key=value]... [-o OUT.json]
+//   nhi list [--markdown | --json]   systems (parameters, defaults), methods, compositions
 // Exit status: 0 run ok; 3 run ended with status "failed" (the result is still
 // written); 2 bad input or unwritable output (nothing written); 130 interrupted
 // by SIGINT/SIGTERM (nothing written).  The output file is written to a
@@ -8,6 +9,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "nhi/output.hpp"
 #include "nhi/scene.hpp"
@@ -18,6 +20,62 @@ namespace {
 int error(const std::string& message, int code = 2) {
   std::cerr << "nhi: error: " << message << "\n";
   return code;
+}
+
+// A number as the scene file would write it.
+std::string num(const nhi::json& x) {
+  std::ostringstream os;
+  os << x.get<double>();
+  return os.str();
+}
+
+std::string params_of(const nhi::json& sys) {
+  std::string out;
+  for (const auto& [k, v] : sys["params"].items()) out += (out.empty() ? "" : ", ") + k + " = " + num(v);
+  return out.empty() ? "-" : out;
+}
+
+std::string method_keys(const nhi::json& m) {
+  std::string out = "\"method\": \"" + m["method"].get<std::string>() + "\"";
+  if (!m["discretization"].is_null())
+    out += ", \"discretization\": \"" + m["discretization"].get<std::string>() + "\", \"alpha\": " + num(m["alpha"]);
+  if (m["composition"] != "none") out += ", \"composition\": \"" + m["composition"].get<std::string>() + "\"";
+  return out;
+}
+
+std::string yes(const nhi::json& b) { return b.get<bool>() ? "yes" : "no"; }
+
+std::string list_text(const nhi::json& c) {
+  std::ostringstream os;
+  os << "systems (\"system\"; \"params\" with their defaults):\n";
+  for (const auto& s : c["systems"])
+    os << "  " << s["name"].get<std::string>() << "  n = " << s["n"] << ", m = " << s["m"] << "; " << params_of(s)
+       << "\n";
+  os << "methods (label: scene keys; order):\n";
+  for (const auto& m : c["methods"])
+    os << "  " << m["label"].get<std::string>() << ": " << method_keys(m) << "; order " << m["order"]
+       << (m["symmetric"].get<bool>() ? ", symmetric" : "") << (m["implicit"].get<bool>() ? ", implicit" : "")
+       << "\n";
+  os << "compositions (\"composition\", of a symmetric method):\n";
+  for (const auto& k : c["compositions"])
+    os << "  " << k["name"].get<std::string>() << "  order " << k["order"] << ", " << k["stages"] << " stages\n";
+  return os.str();
+}
+
+std::string list_markdown(const nhi::json& c) {
+  std::ostringstream os;
+  os << "## scenes\n\n| system | n | m | parameters (defaults) | reversible | separable |\n|---|---|---|---|---|---|\n";
+  for (const auto& s : c["systems"])
+    os << "| `" << s["name"].get<std::string>() << "` | " << s["n"] << " | " << s["m"] << " | " << params_of(s) << " | "
+       << yes(s["reversible"]) << " | " << yes(s["separable"]) << " |\n";
+  os << "\n## methods\n\n| label | scene keys | order | symmetric | implicit | composable |\n|---|---|---|---|---|---|\n";
+  for (const auto& m : c["methods"])
+    os << "| " << m["label"].get<std::string>() << " | `" << method_keys(m) << "` | " << m["order"] << " | "
+       << yes(m["symmetric"]) << " | " << yes(m["implicit"]) << " | " << yes(m["composable"]) << " |\n";
+  os << "\n## compositions\n\n| composition | order | stages |\n|---|---|---|\n";
+  for (const auto& k : c["compositions"])
+    os << "| `" << k["name"].get<std::string>() << "` | " << k["order"] << " | " << k["stages"] << " |\n";
+  return os.str();
 }
 
 }  // namespace
@@ -34,11 +92,20 @@ int main(int argc, char** argv) {
   run->add_option("--set", sets, "Override one scene key: key=JSON value (or a bare string)")
       ->allow_extra_args(false);
   run->add_option("-o,--output", out_path, "Result file (default: standard output)");
+  auto* list = app.add_subcommand("list", "List the systems (parameters, defaults), methods and compositions");
+  bool markdown = false, as_json = false;
+  auto* md_flag = list->add_flag("--markdown", markdown, "As Markdown tables (the README's)");
+  list->add_flag("--json", as_json, "As JSON")->excludes(md_flag);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     return error(e.what());
+  }
+  if (list->parsed()) {
+    const nhi::json c = nhi::catalog();
+    std::cout << (as_json ? c.dump(2) + "\n" : markdown ? list_markdown(c) : list_text(c));
+    return 0;
   }
 
   nhi::json resolved;

@@ -1,4 +1,4 @@
-// The sweep of issue 14 (make sweep, not part of make reproduce): where each
+// The fate-map sweep (make sweep, not part of make reproduce): where each
 // method's runs fail, over a fine grid of h, the coupling parameter (epsilon)
 // and a family of initial conditions.
 //   scenes      every registered scene whose system declares a section family

@@ -11,6 +11,7 @@
 // tests/test_embedding.cpp) assert what these series show.
 #include "nhi/systems/circle.hpp"
 #include "nhi/systems/robot_extrinsic.hpp"
+#include "nhi/dla_body.hpp"
 #include "study.hpp"
 
 namespace {

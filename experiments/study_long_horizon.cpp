@@ -10,11 +10,10 @@
 // running maxima over every step (and the same for the system's other first
 // integrals, H_y and R of the contact oscillators), plus block means of E - E0 over blocks of
 // 1000 steps for the drift rate.
-//   The reference solution (CVODE) runs 10^5 steps of h (--reference-steps;
-// 10^6 until issue 13's last stop).  Over 10^6 steps its six runs took 152
-// of the study's 333 CPU s and most of make reproduce's untimed phase (CVODE
-// makes ~12 internal steps per step of h, 3.7 us each on the robot); over
-// 10^5 it still shows its energy drifting (README, "Energy and constraints over long horizons").
+//   The reference solution (CVODE) runs 10^5 steps of h (--reference-steps):
+// CVODE makes ~12 internal steps per step of h, so 10^6 steps of it would be
+// about half of the study's CPU time, and over 10^5 it already shows its
+// energy drifting (README, "Studies").
 #include "study.hpp"
 
 namespace {

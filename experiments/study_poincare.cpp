@@ -1,4 +1,4 @@
-// Study 5 (issue 12): Poincare sections of the contact oscillators.
+// Study 5: Poincare sections of the contact oscillators.
 // For every registered scene whose system declares a section family
 // (system.hpp, has_section_states: contact_oscillator and contact_oscillator_nr),
 // 10 initial states on one energy level (H = 3/2, H_y = 1/2, z0 spread over
@@ -7,8 +7,8 @@
 // a leapfrog-type method in y (mp06, the symmetric DLA with alpha = 0) that is
 // exactly every 40 steps, as in McLachlan & Perlmutter (2006) and Modin &
 // Verdier (2020); the others' discrete y oscillation has another period, and a
-// section every 40 steps would drift through y's phase (it did: 11-19 times
-// thicker curves for every such method, the reference's points sampled at 2 pi k
+// section every 40 steps would drift through y's phase (11-19 times thicker
+// curves for every such method, the reference's points sampled at 2 pi k
 // included as 1).  Every section point also records y there (its amplitude).
 // Per initial state and method: the section points, the largest drift of the
 // first integrals over the sections, and a thickness of the section curve

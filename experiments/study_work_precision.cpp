@@ -39,25 +39,21 @@ constexpr double kT_energy_short = 100.0;  // the same run's max |E - E0| over [
 // tolerance down to kTightestTolLongDopri5 for dopri5.  About a minute on two
 // cores for the particle.
 constexpr double kT_long = 1e6;
-// dopri5's 10^6-unit runs stop at this tolerance.  In 7c2a10a's run each of
-// its three tighter ones cost more CPU time than rkf78's run at the same
-// tolerance and ended with a larger energy error (1e-11: 6.9 s, 5.8e-6
-// against 2.9 s, 4.6e-6; 1e-12: 11.0 s, 5.9e-7 against 3.4 s, 4.0e-7; 1e-13:
-// 16.9 s, 5.9e-8 against 4.8 s, 2.8e-8), so none was on the particle's
-// 10^6 front; their cells took 38 of the study's 325 CPU s of cell time
-// (NHI_STUDY_CELL_TIMES=1, a standalone run of 7c2a10a's code).
+// dopri5's 10^6-unit runs stop at this tolerance: each tighter one costs
+// more CPU time than rkf78's run at the same tolerance and ends with a
+// larger energy error, so none is on the particle's 10^6 front, and their
+// cells would be a large share of the study's cell time.
 constexpr double kTightestTolLongDopri5 = 1e-10;
 const std::vector<std::string> kLongScenes = {"particle"};
 constexpr double kSelfTimed = 0.5;  // s (see cpu_energy below)
 // Fixed steps h = 0.4 / 2^j, j = 0 ... kFinestJ; tolerances 10^-e, e = kLoosestTol
 // ... kTightestTolReference (CVODE) or kTightestTolPairs (the explicit pairs).
-// Until issue 13 second-order methods went on to j = 9 and order 4 and
-// energy-preserving ones to j = 6: in 6fc3f85's run none of those finer points
-// was on any scene's cost-error front (either error measure, any horizon) and
-// without them no row of summarize.sh's which-method-when table changed, while
-// they took about a third of the study's CPU time (a second-order method's run
-// at h = 0.4/2^9 over T = 10^4 is 1.3e7 steps).  Order 6 reaches the round-off
-// floor by j = 5.
+// Finer h (to j = 9 for second-order methods, j = 6 for order 4 and the
+// energy-preserving ones) puts no point on any scene's cost-error front
+// (either error measure, any horizon) and changes no row of summarize.sh's
+// which-method-when table, while it would take about a third of the study's
+// CPU time (a second-order method's run at h = 0.4/2^9 over T = 10^4 is
+// 1.3e7 steps).  Order 6 reaches the round-off floor by j = 5.
 constexpr int kFinestJ = 5;
 constexpr int kLoosestTol = 3, kTightestTolReference = 12, kTightestTolPairs = 13;
 volatile double g_sink = 0;  // keeps timed runs from being optimized away
@@ -108,7 +104,7 @@ struct Config {
 template <class S>
 bool long_run(const S& sys, const Config& c) {
   if (c.method.external) return c.method.external_label != "dopri5" || c.param >= kTightestTolLongDopri5 * (1 - 1e-9);
-  if (c.method.spec.kind == "benchmark") return false;  // CVODE: ~50x rkf78's cost per step here
+  if (c.method.spec.kind == "benchmark") return false;  // CVODE: many times rkf78's cost per step here
   const nhi::MethodTraits t = nhi::method_traits(sys, c.method.spec);
   return t.preserves_energy ? c.param >= 0.4 * (1 - 1e-12) : c.param >= 0.1 * (1 - 1e-12);
 }
@@ -269,8 +265,8 @@ int main(int argc, char** argv) {
         // steps (measured, repeated to >= 50 ms); an adaptive run is timed whole.
         // The reference solution's diagnosed run is its own timing when it
         // took >= kSelfTimed: its observer sees one point per 0.1 time units
-        // (~1e5 energies, a few ms: under 1 % of such a run), and the timed
-        // reruns cost ~40 s of the study's CPU time.
+        // (~1e5 energies, a few ms: under 1 % of such a run), and timed
+        // reruns would add a large share of the study's CPU time.
         const bool self_timed = c.method.spec.kind == "benchmark" && cpu_diagnosed >= kSelfTimed;
         row["cpu_energy"] = self_timed                 ? cpu_diagnosed
                             : row["adaptive"].get<bool>() ? cpu_per_run(sys, c, q0, v0, kT_energy)
@@ -284,8 +280,7 @@ int main(int argc, char** argv) {
             // Scaled, not timed again: a fixed-step run by its steps, an
             // external pair (the only adaptive methods run to T_long) by its
             // right-hand-side evaluations, counted in the two runs; a timed
-            // rerun of the pairs to 10^6 doubled the particle's cost
-            // (dopri5 at 1e-13: 20 s a run).
+            // rerun of the pairs to 10^6 would double the particle's cost.
             row["cpu_energy_long"] = c.method.external ? row["cpu_energy"].get<double>() * (double(rhs_long) / double(rhs_energy))
                                                        : cpu_short * (kT_long / kT_energy_short);
             row["max_energy_error_long"] = maxE_long;

@@ -1,13 +1,45 @@
 #!/usr/bin/env bash
 # Markdown tables of the study results (results/*.json -> stdout).  `make
-# reproduce` writes them to results/summary.md; README.md quotes them.
+# reproduce` writes them to results/summary.md; experiments/readme_tables.sh
+# copies the sections README.md shows between its BEGIN/END markers.
 set -euo pipefail
 R=${1:-results}
-# jq: a number to 3 significant digits (scientific when small or large), "-" for null.
+# jq: a number to 3 significant digits (scientific when small or large), "-" for
+# null; the exponent is taken after rounding, so 0.009999 prints 0.01, not 10e-3.
 G='def g: if . == null then "-" elif . == 0 then "0" else
-  (fabs | log10 | floor) as $e |
+  (fabs | log10 | floor) as $e0 |
+  ((. / pow(10; $e0) * 100 | round / 100) | fabs) as $m |
+  (if $m >= 10 then $e0 + 1 else $e0 end) as $e |
   if $e >= -2 and $e < 4 then (. * pow(10; 2 - $e) | round / pow(10; 2 - $e) | tostring)
   else ((. / pow(10; $e) * 100 | round / 100 | tostring) + "e" + ($e | tostring)) end end;'
+# The classical Runge-Kutta methods of the work-precision study.
+CLASSICAL='def classical: . == "rk4" or . == "rkf78" or . == "dopri5";'
+
+# ---- The paper's scenes at the paper's step: Figures 1-4 and 1b-4b ----------
+runs=()
+for s in particle_fig12 robot_fig34; do
+  for m in dla mp06 mp06tj rk4 benchmark; do
+    [ -f "$R/${s}_$m.json" ] && runs+=("$R/${s}_$m.json")
+  done
+done
+if [ ${#runs[@]} -gt 0 ]; then
+echo "## Paper scenes at h = 0.2 (results/particle_fig12_*.json, results/robot_fig34_*.json): Figures 1-4 and 1b-4b"
+echo
+echo "max |E - E0| over t <= 100 and t <= 1000 (the recorded points, every second step) and over the whole run (every step, T = 4000); max |omega(q)v| with the runner's velocity (the DLA's: the central difference); the discrete constraint the method holds (the DLA's omega_d, mp06's omega(q)v)."
+echo
+echo "| scene | method | E0 | max \\|E-E0\\|, t <= 100 | t <= 1000 | whole run | max \\|omega(q)v\\| | max \\|discrete constraint\\| |"
+echo "|---|---|---|---|---|---|---|---|"
+jq -r "$G"'
+  (.scene.system) as $s |
+  (if .scene.method == "dla" then (if .scene.discretization == "symmetric" then "dla-sym" else "dla" end) + " a=\(.scene.alpha)"
+   elif .scene.method == "benchmark" then "reference" else .scene.method end
+   + (if (.scene.composition // "none") != "none" then "+" + .scene.composition else "" end)) as $lab |
+  .energy[0] as $e0 |
+  ([.t, .energy] | transpose) as $p |
+  def window($T): [$p[] | select(.[0] <= $T) | .[1] - $e0 | fabs] | max;
+  "| \($s) | \($lab) | \($e0 | g) | \(window(100) | g) | \(window(1000) | g) | \(.summary.max_abs_energy_error | g) | \(.summary.max_abs_constraint | g) | \(if .discrete_constraint then ([.discrete_constraint[][] | fabs] | max | g) else "-" end) |"' "${runs[@]}"
+echo
+fi
 
 echo "## Convergence (results/convergence.json): fitted order, 4 finest h above 1e-10"
 echo
@@ -82,6 +114,138 @@ jq -r "$G"'
      null | if . == null then "-" else "\(.ns | round) / \(if .r then (.r * 100 | round / 100 | tostring) else "?" end)\(if .it then " / \(.it * 100 | round / 100)" else "" end)" end] | join(" | ")) + " |")' "$R/step_costs.json"
 echo
 
+echo "## Step cost ratios (results/step_costs.json): CPU per step / RK4's on the same scene in the same run, h = 0.2"
+echo
+echo "The methods of the work-precision study, steps from each scene's default state (bench_steps); the CPU times are in results/step_costs.json."
+echo
+jq -r "$G"'
+  ([.benchmarks[] | select(.name | test("/")) | {scene: (.name | split("/")[0]), method: (.name | split("/")[1]), r: .ratio_to_rk4}]) as $rows |
+  ($rows | map(.scene) | unique) as $scenes |
+  ($main | map(gsub(" "; "_")) | map(select(. as $m | $rows | any(.method == $m)))) as $methods |
+  "| method | " + ($scenes | join(" | ")) + " |",
+  "|---|" + ($scenes | map("---|") | join("")),
+  ($methods[] as $m | "| \($m) | " + ([$scenes[] as $s | [$rows[] | select(.scene == $s and .method == $m)][0] |
+     if . == null or .r == null then "-" else (.r | g) end] | join(" | ")) + " |")' \
+  --argjson main "$(jq -c '[.scenes[].runs[].label] | unique' "$R/work_precision.json")" "$R/step_costs.json"
+echo
+jq -r "$G"'"The particle'"'"'s DLA map (alpha = 1/2) costs \(.particle_dla_over_floor | g) times a hand-derived Newton step with the analytic Jacobian (target <= \(.target_ratio))" +
+  (if .nr_mp06_over_floor then "; mp06 on contact_oscillator_nr \(.nr_mp06_over_floor | g) times the step reduced by hand to one scalar equation (experiments/hand_steps.hpp)." else "." end)' "$R/step_costs.json"
+echo
+jq -r "$G"'[.scenes[] | [.runs[] | select((.label == "reference" or .label == "rkf78") and .param == 1e-12 and .cpu_final != null)]
+  | select(length == 2) | (map(select(.label == "reference"))[0].cpu_final / map(select(.label == "rkf78"))[0].cpu_final)] |
+  if length > 0 then "CVODE (the reference solution) at tolerance 1e-12 takes \(min | g) to \(max | g) times the CPU time of rkf78 at 1e-12 to T = 10 (results/work_precision.json)." else empty end' "$R/work_precision.json"
+echo
+
+echo "## Step-cost targets (results/step_costs.json): h = 0.2, a step's CPU time against RK4's on the same scene"
+echo
+echo "| target | measured | met |"
+echo "|---|---|---|"
+jq -r "$G"'
+  (.benchmarks | map({key: .name, value: .}) | from_entries) as $b |
+  def cell($scene; $method; f): $b["\($scene)/\($method)"] | if . == null then null else f end;
+  def row($what; $method; $scenes; $limit; f):
+    [$scenes[] as $s | {s: $s, v: cell($s; $method; f)} | select(.v != null)] as $c |
+    if ($c | length) == 0 then empty else
+    "| \($what) | \($c | map("\(.s) \(.v | g)") | join(", ")) | \(if all($c[]; .v <= $limit) then "yes" elif any($c[]; .v <= $limit) then "on " + ([$c[] | select(.v <= $limit) | .s] | join(", ")) else "no" end) |" end;
+  row("midpoint DLA (alpha = 1/2) <= 3x RK4"; "dla_a=0.5"; ["particle", "robot"]; 3; .ratio_to_rk4),
+  row("symmetric DLA (alpha = 0) <= 3x RK4"; "dla-sym_a=0"; ["particle", "robot"]; 3; .ratio_to_rk4),
+  row("midpoint DLA <= 1.5 Newton iterations per step"; "dla_a=0.5"; ["particle", "robot"]; 1.5; .counters.newton_iterations_per_step),
+  row("mp06 <= 1x RK4"; "mp06"; ["particle", "robot"]; 1; .ratio_to_rk4),
+  row("mp06 <= 1.5x RK4"; "mp06"; ["contact_oscillator", "chaotic_oscillator", "sleigh", "contact_oscillator_nr"]; 1.5; .ratio_to_rk4),
+  row("discrete gradient <= 3x RK4"; "discrete_gradient"; ["particle", "robot", "contact_oscillator", "chaotic_oscillator", "sleigh", "contact_oscillator_nr"]; 3; .ratio_to_rk4),
+  "| particle DLA map <= \(.target_ratio)x the analytic Newton step | \(.particle_dla_over_floor | g) | \(if .particle_dla_over_floor <= .target_ratio then "yes" else "no" end) |"' "$R/step_costs.json"
+echo
+# ---- Which method when (results/work_precision.json) --------------------------
+# Per scene, horizon T and energy-error target: each method's least CPU time to
+# keep max |E - E0| over [0, T] below the target (both tables below).
+WP='
+def extrap: .max_energy_error * ([1, .max_energy_error / ([.max_energy_error_short, 1e-300] | max)] | max);
+def horizon($h; $measured):
+  if $h == "1e2" then {err: .max_energy_error_short, cpu: .cpu_energy_short}
+  elif $h == "1e4" then {err: .max_energy_error, cpu: .cpu_energy}
+  elif $measured then {err: .max_energy_error_long, cpu: .cpu_energy_long}
+  else {err: extrap, cpu: (.cpu_energy * 100)} end;
+def measured_long: [.runs[] | select(.status == "ok" and .max_energy_error_long != null)] | length > 0;
+# input: one scene of work_precision.json; output: [{label, param, err, cpu}], one per
+# method that keeps the error below $tol over $h, fastest first.
+def best($h; $tol):
+  measured_long as $measured |
+  [.runs[] | select(.status == "ok") | select($h != "1e6" or ($measured | not) or .max_energy_error_long != null)
+   | {label: .label, param: .param} + horizon($h; $measured) | select(.err != null and .err <= $tol)]
+  | group_by(.label) | map(min_by(.cpu)) | sort_by(.cpu);
+def horizons: "1e2", "1e4", "1e6";
+def targets: 1e-2, 1e-4, 1e-6, 1e-8;
+def paper_dla: startswith("dla");
+'
+# Scene classes of the decision table (Modin & Verdier's: reversible or not,
+# integrable or not); a scene not listed is a class of its own.
+CLASSES='[{"name": "reversible, integrable", "scenes": ["particle", "robot", "contact_oscillator"]},
+          {"name": "reversible, chaotic", "scenes": ["chaotic_oscillator"]},
+          {"name": "not reversible", "scenes": ["contact_oscillator_nr"]},
+          {"name": "reversible, attracted to a line", "scenes": ["sleigh"]}]'
+# input: work_precision.json; $classes as above.
+CLS='
+def geomean: map(log) | add / length | exp;
+def classes: (.scenes | keys_unsorted) as $all |
+  ($classes | map(.scenes |= map(select(. as $s | $all | index($s))) | select(.scenes | length > 0))) as $cl |
+  $cl + [$all[] | select(. as $s | $cl | all(.scenes | index($s) | not)) | {name: ., scenes: [.]}];
+# One row per class, horizon and pair of targets: the methods that reach every
+# target on every scene of the class, ranked by the geometric mean over those
+# cells of their CPU time over the cell'"'"'s fastest.
+def class_rows: .scenes as $S | classes[] |
+  .name as $c | .scenes as $cs |
+  horizons as $h | ([1e-2, 1e-4], [1e-6, 1e-8]) as $band |
+  [$cs[] as $s | $band[] as $t |
+   {scene: $s, extrap: ($h == "1e6" and ($S[$s] | measured_long | not)),
+    best: ($S[$s] | best($h; $t) | map({key: .label, value: .}) | from_entries)}] as $cells |
+  [$cells[].best | [.[].cpu] | min] as $fastest |
+  ([$cells[].best | keys] | reduce .[1:][] as $k (.[0]; . - (. - $k))) as $common |
+  {class: $c, h: $h, band: $band, n: ($cells | length),
+   extrap: ([$cells[] | select(.extrap) | .scene] | unique),
+   measured: ([$cells[] | select(.extrap | not) | .scene] | unique),
+   rank: ([$common[] as $m |
+     {label: $m,
+      score: ([range(0; $cells | length) as $i | $cells[$i].best[$m].cpu / $fastest[$i]] | geomean),
+      wins: ([range(0; $cells | length) as $i | select($cells[$i].best[$m].cpu == $fastest[$i])] | length),
+      params: [$cells[].best[$m].param]}] | sort_by(.score))};
+'
+
+echo "## Which method when, by scene class (results/work_precision.json)"
+echo
+# The DLA family's places in both tables, so that this sentence is the data's.
+jq -r "$G$WP$CLS"'
+  ([.scenes[].runs[].label | select(paper_dla)] | unique) as $dla |
+  [.scenes[] | horizons as $h | targets as $t | best($h; $t)[0:2][] | .label | select(paper_dla)] as $top |
+  [class_rows | .rank[0:2][] | .label | select(paper_dla)] as $ctop |
+  if ($top + $ctop | length) == 0 then
+    "The paper'"'"'s DLA and its variants (\($dla | join(", "))) are neither first nor second in any row of this table or of the per-scene table (results/summary.md, \"Which method when\")."
+  else
+    "The paper'"'"'s DLA and its variants are first or second in \($ctop | length) rows of this table and \($top | length) of the per-scene table (results/summary.md, \"Which method when\"): \($top + $ctop | unique | join(", "))."
+  end' --argjson classes "$CLASSES" "$R/work_precision.json"
+echo
+echo "One row per scene class, horizon T and pair of energy-error targets: the method with the least CPU time to keep max |E - E0| over [0, T] below the target, scored over the class's scenes and both targets (geometric mean of its CPU time over the fastest method's in each cell; a method counts only if it reaches every target on every scene of the class). \"Fastest in\": the cells where it is the fastest; its h or tolerance in parentheses; \"x\": how much slower (the same score) the runner-up and the best classical Runge-Kutta method (rk4, rkf78, dopri5) are. T = 1e6 is extrapolated where marked, as in the per-scene table of results/summary.md."
+echo
+echo -n "Classes: "
+jq -r "$CLS"'classes | map("\(.name) (\(.scenes | join(", ")))") | join("; ") + "."' \
+  --argjson classes "$CLASSES" "$R/work_precision.json"
+echo
+echo "| scene class | T | targets | method (h or tol) | fastest in | runner-up | x | best classical | x |"
+echo "|---|---|---|---|---|---|---|---|---|"
+jq -r "$G$WP$CLASSICAL$CLS"'
+  def span: unique | if length > 1 then "\(first | g) to \(last | g)" else (.[0] | g) end;
+  class_rows | .rank as $rank |
+  ([$rank[] | select(.label | classical)][0]) as $rk |
+  (if (.extrap | length) == 0 then "" elif (.measured | length) == 0 then " (extrap.)"
+   else " (extrap. but \(.measured | join(", ")))" end) as $tag |
+  "| \(.class) | \(.h)\($tag) | \(.band | map(g) | join(", ")) | " +
+  (if ($rank | length) == 0 then "none reaches every target | - | - | - | - | -"
+   else $rank[0] as $b |
+     "\($b.label) (\($b.params | span)) | \($b.wins) of \(.n) | " +
+     (if ($rank | length) > 1 then "\($rank[1].label) | \($rank[1].score / $b.score | g)" else "- | -" end) + " | " +
+     (if $rk == null then "none | -" else "\($rk.label) | \($rk.score / $b.score | g)" end) end) + " |"' \
+  --argjson classes "$CLASSES" "$R/work_precision.json"
+echo
+
 echo "## Which method when (results/work_precision.json): least CPU time to keep max |E - E0| below a target"
 echo
 echo "Per scene, horizon and target: the method (and its h or tolerance) that keeps the largest energy"
@@ -94,21 +258,40 @@ echo "measured growth continued as a power law), CPU(1e6) = 100 CPU(1e4)."
 echo
 echo "| scene | T | target | fastest (h or tol) | CPU s | runner-up | x slower | best classical | x slower |"
 echo "|---|---|---|---|---|---|---|---|---|"
-jq -r "$G"'
-  def extrap: .max_energy_error * ([1, .max_energy_error / ([.max_energy_error_short, 1e-300] | max)] | max);
-  def horizon($h; $measured):
-    if $h == "1e2" then {err: .max_energy_error_short, cpu: .cpu_energy_short}
-    elif $h == "1e4" then {err: .max_energy_error, cpu: .cpu_energy}
-    elif $measured then {err: .max_energy_error_long, cpu: .cpu_energy_long}
-    else {err: extrap, cpu: (.cpu_energy * 100)} end;
-  .scenes | to_entries[] | .key as $s |
-  [.value.runs[] | select(.status == "ok")] as $runs |
-  ([$runs[] | select(.max_energy_error_long != null)] | length > 0) as $measured |
-  ("1e2", "1e4", "1e6") as $h | (1e-2, 1e-4, 1e-6, 1e-8) as $tol |
+jq -r "$G$WP$CLASSICAL"'
+  .scenes | to_entries[] | .key as $s | .value as $scene |
+  ($scene | measured_long) as $measured |
+  horizons as $h | targets as $tol |
   (if $h == "1e6" and ($measured | not) then " (extrap.)" else "" end) as $tag |
-  ([$runs[] | select($h != "1e6" or ($measured | not) or .max_energy_error_long != null)
-   | {label: .label, param: .param} + horizon($h; $measured) | select(.err != null and .err <= $tol)]
-   | group_by(.label) | map(min_by(.cpu)) | sort_by(.cpu)) as $best |
-  ([$best[] | select(.label == "rk4" or .label == "rkf78" or .label == "dopri5")][0]) as $rk |
+  ($scene | best($h; $tol)) as $best |
+  ([$best[] | select(.label | classical)][0]) as $rk |
   if ($best | length) == 0 then "| \($s) | \($h)\($tag) | \($tol | g) | none reaches it | - | - | - | - | - |"
   else "| \($s) | \($h)\($tag) | \($tol | g) | \($best[0].label) (\($best[0].param | g)) | \($best[0].cpu | g) | \(if ($best | length) > 1 then $best[1].label else "-" end) | \(if ($best | length) > 1 then ($best[1].cpu / $best[0].cpu | g) else "-" end) | \(if $rk then $rk.label else "none" end) | \(if $rk then ($rk.cpu / $best[0].cpu | g) else "-" end) |" end' "$R/work_precision.json"
+
+# ---- The fate-map sweep (make sweep; not part of make reproduce) --------------
+if [ -f "$R/fate_map.json" ]; then
+echo
+echo "## Fate map (results/fate_map.json): largest h with every run stable"
+echo
+jq -r '"\(.size.runs) runs of T = \(.config.T), \(.config.states) initial states on one energy level, h from \(.config.h | min) to \(.config.h | max) (\(.config.h | length) values); per scene, \(.config.param) and method the largest grid h up to which every run is stable (|E - E0| <= |E0| to T, solves converged, finite)."' "$R/fate_map.json"
+echo
+jq -r "$G"'
+  .config.values as $v |
+  "| scene | method | " + ($v | map("\(.)") | map("epsilon = " + .) | join(" | ")) + " |",
+  "|---|---|" + ($v | map("---|") | join("")),
+  (.scenes | to_entries[] | .key as $s | .value.by_value as $bv |
+   ($bv[0].methods | map(.label))[] as $l |
+   "| \($s) | \($l) | " + ([$bv[] | .methods[] | select(.label == $l) | .largest_h_all_stable | g] | join(" | ")) + " |")' "$R/fate_map.json"
+fi
+if [ -f "$R/fate_map_scaling.json" ]; then
+echo
+echo "## Fate-map scaling (results/fate_map_scaling.json): the sweep with N ranks of one thread"
+echo
+jq -r "$G"'
+  "The same sweep (\(.size.runs) runs) on \(.cores) cores; every run'"'"'s JSON equal to the first'"'"'s: \(all(.runs[]; .identical_to_first)).",
+  "",
+  "| ranks | wall s | busy s per rank | speed-up |",
+  "|---|---|---|---|",
+  (.runs[0].wall_seconds as $w1 | .runs[] |
+   "| \(.ranks) | \(.wall_seconds | g) | \(.busy_seconds | map(g) | join(", ")) | \($w1 / .wall_seconds | g) |")' "$R/fate_map_scaling.json"
+fi

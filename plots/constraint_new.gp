@@ -1,4 +1,4 @@
-# Companion to Figures 2 and 4 (issue 11): |omega_a(q) v| along the paper's
+# Companion to Figures 2 and 4: |omega_a(q) v| along the paper's
 # DLA (central-difference velocities), mp06 and its triple jump (v_k = V(q_k, p_k),
 # which they keep in the constraint distribution), RK4 and the reference
 # solution, h = 0.2, log scale.  Exact zeros are not drawn.  Called as

@@ -1,4 +1,4 @@
-# Companion to Figures 1 and 3 (issue 11): energy along the paper's DLA
+# Companion to Figures 1 and 3: energy along the paper's DLA
 # (alpha = 1/2), McLachlan & Perlmutter's mp06 and its triple-jump composition
 # (order 4), RK4 and the reference solution, h = 0.2.  Called as plots/energy.gp
 # (stem, out, label), reading stem_{dla,mp06,mp06tj,rk4,benchmark}.json.  Line
@@ -11,10 +11,7 @@ rk4 = stem."_rk4.json"
 ref = stem."_benchmark.json"
 # $ref, $dla, $mp, $mptj, $rk4: t and E - E_0 of each run, E_0 the reference's
 # first energy, from one jq pass over the five files, ref first (jq_script,
-# plots/style.gp; it also spares the replot a second pass).  E_0 used to
-# make a round trip through gnuplot (printed by jq, read, printed with %.17g
-# into the jq filter of each series): both prints are exact, so it is the
-# same double as the one here.
+# plots/style.gp; it also spares the replot a second pass).
 load jq_script("-n", \
   'input as $ref | $ref.energy[0] as $E0 | def e: [.t, (.energy | map(. - $E0))] | transpose[]; ' . \
   'jq_block("$ref"; $ref | e), (("dla", "mp", "mptj", "rk4") as $name | input | jq_block("$\($name)"; e)), ' . \

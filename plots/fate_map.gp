@@ -1,4 +1,4 @@
-# The sweep of issue 14 (make sweep): for one scene, one panel per value of the
+# The fate-map sweep (make sweep): for one scene, one panel per value of the
 # swept parameter; per method (rows) and h (columns) the fraction of the
 # initial states whose run stayed stable to T (colour), and the largest h up to
 # which every run was stable (black square; none where even the smallest h fails).

@@ -5,8 +5,9 @@ load "plots/style.gp"
 # Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
 #   N; LABEL, GROUP, STY[i + 1] of method i (label: fate, group, 10 + style);
 #   H (as text: the title prints it as is), T; RS, the reference solution's
-#   steps (config.reference_steps; 10^6 before it was recorded); FI, the names of the first
-#   integrals besides E (the contact oscillators: H_y, R), from method 0;
+#   steps (config.reference_steps; 10^6 where the file does not record it);
+#   FI, the names of the first integrals besides E (the contact oscillators:
+#   H_y, R), from method 0;
 #   $E<i>, $C<i>: t and max |E - E0|, max constraint of method i if in the
 #   "main" group, $V<i>: t and max |E - E0| if in the "variant" group;
 #   $F<i>_<k>: t and max |I - I0| of the k-th name of FI if in "main".

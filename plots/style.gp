@@ -33,14 +33,12 @@ set style line 31 lc rgb "#000000" pt 2  lw 1.5   # dopri5 (Boost.Odeint)
 set style line 32 lc rgb "#aec7e8" pt 3  lw 1.5   # (next method)
 set style line 33 lc rgb "#98df8a" pt 5  lw 1.5
 set style line 34 lc rgb "#ff9896" pt 7  lw 1.5
-# One jq pass per figure.  Calling jq once per label and per data series cost
-# ~20 ms to start and ~40 ms to parse the result each time, ~240 times a figure
-# for the long-horizon study: ~100 CPU s of make reproduce for the study figures.  A script instead
+# One jq pass per figure: calling jq once per label and per data series would
+# start jq and parse the result hundreds of times a figure.  A script
 # `load`s jq_script(opts, prog, files): the gnuplot commands that ONE run of
 # `jq -r opts prog files` prints, i.e. assignments of the labels, styles and
-# numbers, and every series as a datablock (jq_block) holding the text the
-# series' own jq call printed before (@tsv prints a number the same way in any
-# pass), so the figures are byte-identical.
+# numbers, and every series as a datablock (jq_block) holding its rows as
+# @tsv text.
 # prog is written in gnuplot single quotes and goes to the shell in single
 # quotes: it must not contain a ' (nor may opts and files need quoting).  Its
 # last output must be "jq_ok = 1": jq stops at its first error (the message
@@ -49,11 +47,11 @@ set style line 34 lc rgb "#ff9896" pt 7  lw 1.5
 # `set output` creates the PNG, instead of drawing an empty figure.
 # Defined for prog:
 #   gp     the gnuplot string literal of this value as system("jq -r ...")
-#          returned it (a string raw, any other value as JSON); numbers are
-#          converted by the same int()/real() calls as before.
+#          would return it (a string raw, any other value as JSON); the
+#          scripts convert numbers with int()/real().
 #   jq_block($name; rows)   datablock $name, one @tsv line per row.  It is
-#          empty where rows is: gnuplot then skips it with the same
-#          "no valid points" warning, and no key entry, as an empty "< jq".
+#          empty where rows is: gnuplot then skips it with a
+#          "no valid points" warning, and no key entry.
 JQ_DEFS = 'def gp: (if type == "string" then . else tojson end) | tojson; ' . \
           'def jq_block($name; rows): "\($name) << EOD", (rows | @tsv), "EOD"; '
 jq_script(opts, prog, files) = sprintf("< jq -r %s '%s%s' %s", opts, JQ_DEFS, prog, files)

@@ -30,7 +30,7 @@ S make_system() {
 }
 
 // The system's default initial state (the numbers of experiments/scenes/NAME.json;
-// test_scene checks that they agree).
+// test_scenes.cpp checks that they agree).
 template <class S>
 void scene_state(Vec<double, S::n>* q, Vec<double, S::n>* v) {
   *q = S::default_q0();
@@ -58,6 +58,16 @@ void random_state(std::mt19937& rng, Vec<double, S::n>* q, Vec<double, S::n>* v,
   const Mat<double, S::m, S::n> W = sys.template omega<double>(*q);
   const Mat<double, S::m, S::m> G = W * W.transpose();
   *v = w - W.transpose() * G.ldlt().solve(W * w);
+}
+
+// A random phase point: q_i, p_i uniform in [-r, r], drawn in turn.
+template <int n>
+void random_phase(std::mt19937& rng, double r, Vec<double, n>* q, Vec<double, n>* p) {
+  std::uniform_real_distribution<double> u(-r, r);
+  for (int i = 0; i < n; ++i) {
+    (*q)[i] = u(rng);
+    (*p)[i] = u(rng);
+  }
 }
 
 // Harmonic oscillator with no constraints, L = 1/2 v^2 - 1/2 k q^2 (n = 1, m = 0):

@@ -1,4 +1,4 @@
-// The `nhi run` command line, driven as a user (or an outside check) drives it:
+// The `nhi` command line (run, list), driven as a user (or an outside check) drives it:
 // exit codes, one-line errors, result files whole or absent.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -12,7 +12,10 @@
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
+
+#include "nhi/scene.hpp"
 
 namespace {
 
@@ -113,6 +116,10 @@ std::vector<BadScene> bad_scenes() {
   auto R = [](const F& f) { return edited(robot_scene(), f); };
   return {
       {"truncated JSON", R"({"system": "particle", "q0": [1, 0.5)", ""},
+      // Nested 10^5 deep: printing or walking it overflowed the stack (exit 139).
+      {"an array nested 100000 deep", std::string(100000, '[') + std::string(100000, ']'), ""},
+      {"a scene key nested 100000 deep", raw("q0", std::string(100000, '[') + "1" + std::string(100000, ']')), ""},
+      {"--set value nested 100000 deep", particle_scene().dump(), "--set 'q0=" + std::string(100000, '[') + std::string(100000, ']') + "'"},
       {"empty file", "", ""},
       {"not an object", "[1, 2, 3]", ""},
       {"a bare string", "\"particle\"", ""},
@@ -192,8 +199,19 @@ TEST_F(Cli, HostileScenesFailWithOneLineAndTouchNoFile) {
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
 }
 
+// A scene nested beyond the limit is refused while it is parsed, by a message
+// naming the limit (deeper values would overflow the stack).
+TEST_F(Cli, DeeplyNestedSceneIsRefusedNamingTheLimit) {
+  const std::string file = write("deep.json", std::string(100000, '[') + std::string(100000, ']'));
+  const std::string out = path("deep_out.json");
+  const Result r = run("run " + file + " -o " + out);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("nested deeper than 64 levels"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // A run whose recorded points cannot fit in memory is refused before it starts
-// (issue 10, item 8): exit 2, one line naming output_every, nothing written.
+// exit 2, one line naming output_every, nothing written.
 TEST_F(Cli, RunTooLargeForMemoryIsRefusedBeforeItStarts) {
   const std::string out = path("big.json");
   const Result r = run("run " + scene() + " --set method=rk4 --set h=0.01 --set steps=100000000 -o " + out);
@@ -201,6 +219,43 @@ TEST_F(Cli, RunTooLargeForMemoryIsRefusedBeforeItStarts) {
   EXPECT_NE(r.err.find("scene key 'output_every'"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// `nhi list` names every registered system with its parameters' defaults,
+// every study method and every composition, as text, Markdown and JSON; every
+// system and method it lists runs from a scene.
+TEST_F(Cli, ListNamesEverySystemMethodAndComposition) {
+  const std::string out = path("list.json");
+  ASSERT_EQ(run("list --json > " + out).code, 0);
+  const json c = json::parse(std::ifstream(out));
+  std::vector<std::string> systems;
+  for (const auto& s : c["systems"]) systems.push_back(s["name"]);
+  EXPECT_EQ(systems, nhi::system_names());
+  ASSERT_FALSE(c["methods"].empty());
+  for (const auto& s : c["systems"]) EXPECT_FALSE(s["params"].empty()) << s["name"];
+  std::set<std::string> kinds;
+  for (const auto& m : c["methods"]) {
+    kinds.insert(m["method"].get<std::string>());
+    EXPECT_GE(m["order"].get<int>(), 1) << m["label"];
+  }
+  EXPECT_EQ(kinds.size(), 5u);
+  EXPECT_EQ(c["compositions"].size(), 4u);
+  // Each listed method runs on each listed system's default state.
+  for (const auto& s : c["systems"])
+    for (const auto& m : c["methods"]) {
+      json scene = {{"system", s["name"]}, {"q0", s["q0"]}, {"v0", s["v0"]}, {"method", m["method"]},
+                    {"composition", m["composition"]}, {"h", 0.05}, {"steps", 3}};
+      if (!m["discretization"].is_null()) scene["discretization"] = m["discretization"], scene["alpha"] = m["alpha"];
+      EXPECT_EQ(run("run " + write("listed.json", scene.dump()) + " -o " + path("listed_out.json")).code, 0)
+          << s["name"] << " " << m["label"];
+    }
+  const std::string md = path("list.md");
+  ASSERT_EQ(run("list --markdown > " + md).code, 0);
+  std::stringstream text;
+  text << std::ifstream(md).rdbuf();
+  for (const char* heading : {"## scenes\n", "## methods\n", "## compositions\n"})
+    EXPECT_NE(text.str().find(heading), std::string::npos) << heading;
+  EXPECT_EQ(run("list --markdown --json").code, 2);
 }
 
 TEST_F(Cli, BadCommandLinesFailWithOneLine) {

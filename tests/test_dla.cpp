@@ -4,6 +4,7 @@
 #include <array>
 #include <string>
 
+#include "nhi/dla_body.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {
@@ -257,7 +258,7 @@ TYPED_TEST(DlaTest, MomentumIsD2OfTheAcceptedStepBitForBit) {
 }
 
 // The stepper does not evaluate omega again at a constraint node whose
-// coordinates omega reads are the same bits (OmegaMemo, issue 13).  That is
+// coordinates omega reads are the same bits (OmegaMemo).  That is
 // right only if omega_reads() (hamiltonian.hpp) finds every coordinate omega depends on: here a
 // coordinate it leaves out never changes omega, one it lists does, and the
 // memo gives omega(q) bit for bit along a sequence of states in which the
@@ -331,11 +332,11 @@ TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
 // correction (exact Jacobian, matrix 7) from each accepted q_{k+1} moves each
 // coordinate by half an ulp at most, at most eps |q|_inf / 2, so by
 // eps |q|_inf / 4 on average over steps; asserted: 0.3 eps |q|_inf.  The check
-// alone accepts up to 16 eps of its scale, and at small h that let through
-// offsets smooth from step to step: mean corrections of 0.94 (contact
-// oscillator, midpoint rule, h = 0.4 / 2^8), 2.0 (chaotic oscillator) and 1.03
-// (sleigh, h = 0.4 / 2^9) eps |q|_inf, and a drift of the mean energy error
-// (experiments/speed_log.md, "Kept accurate"); with the correction at most 0.18.  *accepted_share
+// alone accepts up to 16 eps of its scale, and at small h that would let
+// through offsets smooth from step to step, mean corrections of the order of
+// eps |q|_inf (the contact oscillator's midpoint rule at h = 0.4 / 2^8, the
+// chaotic oscillator, the sleigh at h = 0.4 / 2^9), and a drift of the mean
+// energy error; with the correction at most 0.18.  *accepted_share
 // gets the share of steps the check accepted, so that the assertion is not
 // empty where it matters: at small h the passes of a separable scene reach
 // the check on at least 79 % of the steps (measured), asserted 50 %.

@@ -1,4 +1,4 @@
-// The DLA composed by the triple jump (issue 11): the variable-step recursion
+// The DLA composed by the triple jump: the variable-step recursion
 //     D2 L_d^{h_{k-1}}(q_{k-1}, q_k) + D1 L_d^{h_k}(q_k, q_{k+1}) = omega(q_k)^T lambda_k
 // with h_k cycling through gamma_1 h, gamma_2 h, gamma_3 h (gamma_1 = gamma_3 =
 // 1/(2 - 2^(1/3)), gamma_2 = 1 - 2 gamma_1 < 0) is of order 4 in q after whole

@@ -5,6 +5,7 @@
 //  - The robot with its circles as unit vectors (a nonlinear embedding, outside
 //    the theorem): a different second-order integrator; how it differs.
 #include "nhi/systems/robot_extrinsic.hpp"
+#include "nhi/dla_body.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {

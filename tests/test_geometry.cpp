@@ -5,6 +5,8 @@
 //  - Section 5.1: with no constraints the one-step map (q, p) -> (q', p') is
 //    symplectic; with constraints it is not.
 #include "nhi/systems/circle.hpp"
+#include "nhi/dla_body.hpp"
+#include "nhi/reference_body.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {

@@ -116,7 +116,7 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
       while (!enough() && hs.front() < 0.8) run_at(2 * hs.front(), true);
       if (enough()) break;
     }
-    const double tol = p >= 4 ? 0.2 : (p == 2 ? 0.1 : 0.15);  // as test_convergence always had
+    const double tol = p >= 4 ? 0.2 : (p == 2 ? 0.1 : 0.15);  // the tolerances of test_convergence
     struct {
       std::optional<double> order;
     } fq{asymptotic_order(hs, eq)}, fv{asymptotic_order(hs, ev)}, fE{asymptotic_order(hs, eE)};
@@ -312,15 +312,13 @@ TYPED_TEST(ReversibleSceneContract, SymmetricMethodsKeepTheEnergyBounded) {
 }
 
 // Methods that declare preserves_energy keep |E_k - E_0| at round-off over
-// 10^4 steps of h = 0.2 (issue 11), on every scene.  Round-off here is a
+// 10^4 steps of h = 0.2, on every scene.  Round-off here is a
 // linear accumulation of a few eps of the energy's terms per step: the step
 // equations are solved to their rounding floor, which leaves each step's
 // energy change at a few eps of |T| + |U| (kinetic and potential parts, the
 // robot's potential swings to 10 while E = 1.5), and those errors do not
-// cancel.  Measured (09ccceb): the plain scheme 1.95e-14 on the particle and
-// 1.23e-12 on the robot, its triple jump 8.3e-14 and 1.33e-10 (0.70 of the
-// bound); the bound below is 4 eps (|T| + |U|)_max
-// per step, N steps.
+// cancel.  The bound below is 4 eps (|T| + |U|)_max per step, N steps; the
+// robot's triple jump comes closest to it (about 0.7 of it).
 // A second-order method that does not preserve it has 1e-3 ... 1e-1 here.
 TYPED_TEST(MethodContract, EnergyPreservingMethodsKeepItToRoundOff) {
   using S = TypeParam;

@@ -40,9 +40,8 @@ TEST(Robot, ReducedSolutionMatchesTheBenchmark) {
 // no bias; Newton from the plain start stops up to ~ eps |q|_inf / 2 away and
 // biased (measured: psi off by +0.62 eps |q|_inf on average over 2e4 steps,
 // mean |offset| 0.43-0.72 per coordinate, against |mean| <= 0.001 and mean
-// |offset| <= 0.026 for the fast path).  So where the two differ at small h
-// (experiments/speed_log.md: "What moved in results/", 4431b14), the fast path is
-// the accurate one.
+// |offset| <= 0.026 for the fast path).  So where the two differ at small h,
+// the fast path is the accurate one.
 TEST(Robot, DlaFastPathIsTheExactStepToRoundOff) {
   using S = Robot;
   using D = AlphaDiscretization;

@@ -157,7 +157,7 @@ TYPED_TEST(SystemTest, EnergyIsConservedAlongTheBenchmark) {
 }
 
 // particle.hpp writes omega's first two entries as one pair (-y)(1, 0), for
-// speed (issue 13): it is still the paper's row (-y, 0, 1), in double and in
+// speed: it is still the paper's row (-y, 0, 1), in double and in
 // the Jet the solver differentiates, whatever the sign and size of y.
 TEST(Particle, OmegaIsThePapersRowWrittenAsOnePair) {
   const Particle sys;

@@ -75,28 +75,15 @@ struct starts_from_multiplier<Inner, std::void_t<decltype(Inner::starts_from_mul
 // the sleigh), stage i starts from its own multiplier of the last composed
 // step (one of the same sign of h), not from that of stage i - 1, which
 // acts over a step of another size and, for a backward stage, in the other
-// direction.  Measured on the sleigh, mp06's triple jump at h = 0.2 from the
-// default state (scratch, Newton iterations per composed step by blocks of
-// 100 composed steps): from stage i - 1 5.43 2.86 2.89 3.00 3.00 ... for
-// ever; from stage i's own 5.89 3.03 1.42 0.00 0.00 ....  Once the sleigh
-// runs straight its multiplier is round-off (~1e-15), and each stage's own
-// round-off value is a fixed point of that stage, which its own memory
-// hits exactly, while the previous stage's differs by a few ulps of the
-// residual's terms and costs a Newton iteration at every stage.  (An
-// extrapolation of stage i's last two multipliers, lambda_1 + (h / h_1)
-// (lambda_1 - lambda_2), did not reach that regime within 10^3 composed
-// steps in 3ee564d's session, 2.75-2.99 iterations a step; written
-// 2 lambda_1 - lambda_2 it did, 0.23 in the third block: which of them
-// locks in depends on single roundings, the plain memory did here.)
-// With the solver's rounding terms (solver.hpp, mp06.hpp), stages started
-// from the previous stage's multiplier lock in too (no Newton iteration
-// after ~180 composed steps), with slightly fewer iterations than the
-// memory's.  The memory still saves residual evaluations on the triple jump
-// and order 6 (its starts need the rounding terms less often; not on Suzuki
-// 5: 9.13 against 8.71 a composed step over 10^3) and time on all three:
-// scratch, min of 5 x 2x10^5 steps at h = 0.2 restarted every 10^3, with
-// the memory against without, triple jump 184 against 221 ns, Suzuki 5 351
-// against 369, order 6 582-602 against 677-685.
+// direction.  Once the sleigh runs straight its multiplier is round-off
+// (~1e-15), and each stage's own round-off value is a fixed point of that
+// stage, which its own memory hits exactly, while the previous stage's
+// differs by a few ulps of the residual's terms.  With the solver's rounding
+// terms (solver.hpp, mp06.hpp) stages started from the previous stage's
+// multiplier lock in too; the memory still saves residual evaluations on
+// the triple jump and order 6 (its starts need the rounding terms less
+// often; not on Suzuki 5) and time on all three (the counts:
+// tests/test_composition.cpp, Composition.Mp06StagesStartFromTheirOwnMultipliers).
 template <class Inner>
 class Composed {
  public:
@@ -119,7 +106,7 @@ class Composed {
     // conditions then do not tell the whole story: measured on both paper
     // scenes, its triple jump and Suzuki compositions are of order 4 but
     // Kahan-Li's order-6 one is of order 4 too (tests/test_methods.cpp,
-    // README "Methods after the paper").  We declare what we measured.
+    // README "Methods").  We declare what we measured.
     t.order = t.holds_velocity_constraint ? c_.order : std::min(c_.order, 4);
     // For the same reason its reported v keeps the inner order: the O(stage^2)
     // constraint violation at every grid point is in v.
@@ -135,13 +122,9 @@ class Composed {
 
   // Written so that a stage pays for the memory only two copies of the
   // multiplier (its start and its result): the retry out of line, each
-  // stage's summary constructed in place.  4dc76ca's form (a default summary move-assigned from the step,
-  // the retry inline) cost up to a sixth of a composed step where the inner
-  // step is cheap and needs no memory (scratch, min of 5 x 2x10^5 steps, h =
-  // 0.2, the composed step before 61ee5ff's memory against 4dc76ca's: the
-  // particle's triple jump 73 -> 86 ns, the contact oscillator's 69 -> 78,
-  // the robot's 247 -> 262; bench_steps side by side in
-  // experiments/speed_log.md, "What made steps faster").
+  // stage's summary constructed in place.  A default summary move-assigned
+  // from the step, with the retry inline, would cost a noticeable share of a
+  // composed step where the inner step is cheap and needs no memory.
   StepSummary step(double h) {
     StepSummary total;
     // Stage memory (above): the last composed step was one of h's sign.
@@ -187,11 +170,11 @@ class Composed {
   static constexpr bool kStageMemory = starts_from_multiplier<Inner>::value;
 
   // A stage that failed from its own multiplier is retried from the
-  // previous stage's, the start it had before: at large h the last composed
-  // step's multiplier can be the farther one.  A defensive fallback, not
-  // shown to pay: on the sleigh at h >= 1.26, beyond every largest stable h,
-  // which runs limp to T changed with the memory and did not change back
-  // with the retry (round-off decides there).  The inner stepper's failure
+  // previous stage's, the start it would have without the memory: at large h
+  // the last composed step's multiplier can be the farther one.  A defensive
+  // fallback, not shown to pay: the runs where the memory changes which steps
+  // fail (the sleigh at h >= 1.26, beyond every largest stable h) are decided
+  // by round-off, with or without the retry.  The inner stepper's failure
   // messages count the retry as a step.  *s: the failed attempt, then the
   // retry's, with both attempts' counts.
   [[gnu::noinline, gnu::cold]] void retry(double h, const Vec<double, m>& previous, StepSummary* s) {

@@ -22,7 +22,7 @@ using Mat = Eigen::Matrix<T, R, C>;
 
 // Is every entry finite?  The same test as Eigen's allFinite(), which
 // computes (x - x) == (x - x) through an unrolled helper that GCC leaves out
-// of line: 10 % of a particle DLA step (issue 13, perf).
+// of line, a noticeable share of a particle DLA step.
 template <class Derived>
 inline bool all_finite(const Eigen::DenseBase<Derived>& x) {
   bool ok = true;

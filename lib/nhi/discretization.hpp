@@ -134,7 +134,7 @@ inline Vec<T, S::n> discrete_lagrangian_slot(const S& sys, const D& disc, double
 // omega_d(q0, q1) (eq. 13 / 14); *scale (optional) gets sum_i w_i |omega(q_c)| |q1-q0|/h,
 // the size of the terms, against which round-off in omega_d is judged.
 // omega_at(k, q_c) gives omega(q_c) at the k-th constraint node (a caller
-// may have it at hand: DlaStepper's passes, issue 13).
+// may have it at hand: DlaStepper's passes).
 template <class S, class D, class T, class OmegaAt>
 inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& disc, double h,
                                              const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,

@@ -47,7 +47,7 @@ using DlaOptions = SolverOptions;
 // coordinates are the same bits gets the same omega without evaluating it.
 // On the robot theta is exact after the predictor's first pass, so its
 // sincos is taken once or twice a step instead of at every pass and
-// residual (issue 13).
+// residual.
 template <class S, int kNodes>
 struct OmegaMemo {
   static constexpr int n = S::n, m = S::m;
@@ -220,10 +220,8 @@ class DlaMap {
       // p_{k+1} = D2 L_d(q_k, q_{k+1}): the last residual's when it was taken
       // at this q_{k+1} to the bit (the residual check accepted the guess as
       // it was; the same sums in the same order, so the same p_{k+1} as
-      // evaluating it here, which is the fallback).  It saves the partials at
-      // every node (the robot's cos psi): measured in a scratch run at
-      // h = 0.2, the symmetric DLA's step 9-12 % faster on the particle and
-      // the oscillators, the robot's midpoint DLA ~4 % (issue 13).
+      // evaluating it here, which is the fallback).  It saves evaluating the
+      // partials at every node again (the robot's cos psi).
       if (prob.d2_valid_ && (prob.d2_at_.array() == q1.array()).all()) {
         *p_next = prob.d2_;
       } else {
@@ -273,7 +271,7 @@ class DlaStepper {
   // where the first pass is exact, gs_) and goes straight to the check (the
   // check, not a further pass, confirms it); otherwise it makes kMinPasses,
   // or kMaxPasses on every 8th step to find out, and is checked only if a
-  // pass moved nothing (issue 13; measured in experiments/speed_log.md).
+  // pass moved nothing.
   static constexpr int kMaxPasses = 4, kMinPasses = 2;
   // Passes that take the curvature of a potential of one coordinate (next_guess)
   // converge quadratically: from the extrapolation the third is at round-off
@@ -288,38 +286,7 @@ class DlaStepper {
   using VecN = Vec<double, n>;
   using VecM = typename Map::VecM;
 
-  DlaStepper(const S& sys, const D& disc, DlaOptions options = {})
-      : map_(sys, disc, 0.0, options), omega_memo_(sys) {
-    if constexpr (kPassesSolveMultipliers) {
-      // M^-1 (constant on a separable system) and kappa = sum_c w_c c (1 - c)
-      // for the curvature of the passes (next_guess).
-      Minv_ = inverse_mass_matrix(map_.system());
-      passes_settle_ = constraint_force_misses_omega(map_.system());
-      for (const Node& nd : map_.discretization().nodes()) kappa_ += nd.weight * nd.c * (1.0 - nd.c);
-      // With kappa = 0 and passes that settle, the Gauss-Seidel pass
-      // (run_passes) is exact in its first pass: one pass, then the check.
-      gs_ = passes_settle_ && kappa_ == 0;
-      if (kappa_ != 0) {
-        // The curvature of the passes is used only where K is constant (a
-        // quadratic potential) and not zero (K = 0: nothing to add).
-        if (const auto K = constant_force_jacobian(map_.system())) {
-          affine_potential_force_ = true;
-          if ((K->array() != 0.0).any()) K_ = *K;
-        } else {
-          // A potential of one coordinate r (the robot's V0 sin psi): the
-          // passes take its curvature at every pass (next_guess).
-          const std::array<bool, n> reads = force_reads(map_.system());
-          int count = 0;
-          for (int j = 0; j < n; ++j)
-            if (reads[j]) {
-              ++count;
-              curvature_coordinate_ = j;
-            }
-          if (count != 1) curvature_coordinate_ = -1;
-        }
-      }
-    }
-  }
+  DlaStepper(const S& sys, const D& disc, DlaOptions options = {});
 
   const S& system() const { return map_.system(); }
   const D& discretization() const { return map_.discretization(); }
@@ -350,74 +317,12 @@ class DlaStepper {
   // effect on the order).  Applies to the next start().
   void start_momentum(const VecN& p0) { p0_ = p0; }
 
-  void start(const VecN& q0, const VecN& v0) {
-    q_prev_ = q_curr_ = q_next_ = q0;
-    p_curr_ = p_next_ = p0_ ? *p0_ : momentum(map_.system(), q0, v0);
-    v0_ = v0;
-    lambda_ = lambda_prev_ = VecM::Zero();
-    steps_ = 0;
-    h_prev_ = h_ = 0;
-    accepted_ = false;
-  }
+  void start(const VecN& q0, const VecN& v0);
 
-  StepSummary step(double h) {
-    VecN guess, plain;
-    VecM lambda_guess;
-    bool settled = false;
-    const bool accepted_last = accepted_;
-    next_guess(h, &guess, &lambda_guess,
-               curvature_coordinate_ >= 0 ? kNewtonPasses
-               : gs_ && accepted_last      ? 1
-               : accepted_last || steps_ % 8 != 0 ? kMinPasses
-                                                  : kMaxPasses,
-               &settled, true);
-    const bool predicted = refines(h);  // next_guess refined q
-    if (predicted) plain = extrapolation(h);
-    const VecM lambda_plain = lambda_;
-    if (steps_ > 0) {
-      q_prev_ = q_curr_;
-      q_curr_ = q_next_;
-      p_curr_ = p_next_;
-    }
-    lambda_prev_ = lambda_;
-    lambda_ = lambda_guess;
-    h_prev_ = h_;
-    h_ = h;
-    map_.set_h(h);
-    // (Only a guess the passes refined is worth the check: where the passes
-    // do not settle, the stages of a composition, none of which follows two
-    // steps in its own direction, get the plain extrapolation, refines().)
-    const bool check = settled || (accepted_last && predicted);
-    StepSummary st = map_.step(
-        q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_, check,
-        [this, h](const Vec<double, n + Map::mc>& r, VecN* q1, VecM* lambda) { polish(h, r, q1, lambda); },
-        predicted ? &guess_Wt_ : nullptr, &omega_memo_);
-    accepted_ = st.ok() && st.jacobians == 0;  // the residual check took the guess
-    if (!st.ok() && predicted) {
-      // A large step can start outside Newton's basin from the predictor
-      // (the sleigh at h = 2): retry from the plain start, the linear
-      // extrapolation and the last multipliers, before the step fails.
-      lambda_ = lambda_plain;
-      StepSummary retry = map_.step(q_curr_, p_curr_, plain, &q_next_, &lambda_, &p_next_);
-      retry.iterations += st.iterations;
-      retry.evaluations += st.evaluations;
-      retry.jacobians += st.jacobians;
-      retry.used_fallback = true;  // counted as a fallback step (RunReport::fallbacks)
-      if (!retry.ok()) retry.message = "from the predictor: " + st.message + "; from the extrapolation: " + retry.message;
-      st = retry;
-    }
-    ++steps_;
-    if (st.status != SolveStatus::kConverged || !all_finite(q_next_)) {
-      if (st.status == SolveStatus::kConverged) st.failure = FailureKind::kNonFinite;
-      st.status = SolveStatus::kFailed;
-      st.message = "step solve for q_" + std::to_string(steps_) + " did not converge: " +
-                   (st.message.empty() ? "non-finite state" : st.message);
-    }
-    return st;
-  }
+  StepSummary step(double h);
 
   // The starting iterate of the next step, of size h, from the newest point
-  // (q_{k+1}, p_{k+1}) (issue 13).  First step: q_0 + h v_0 and lambda = 0;
+  // (q_{k+1}, p_{k+1}).  First step: q_0 + h v_0 and lambda = 0;
   // second step: the linear extrapolation of q and the last multipliers.
   // Otherwise the multipliers, which carry the factor h (L_d does),
   // extrapolate lambda_j / h_j linearly in t from the last two steps (at a
@@ -448,25 +353,21 @@ class DlaStepper {
   //   Rules with an interior node (kappa = sum_c w_c c (1 - c) > 0: alpha = 1/2,
   // the paper's second-order rule) see q_guess in dL/dq too, and frozen there
   // a pass gains only a factor ~ h^2 kappa |d^2 U| (the particle at h = 0.2:
-  // ~0.02), too little to settle in kMinPasses, so Newton took ~1.9
-  // iterations and a Jet evaluation per step.  Where dL/dq is affine in q (a
+  // ~0.02), too little to settle in kMinPasses, so Newton would follow, with
+  // a Jet evaluation, on most steps.  Where dL/dq is affine in q (a
   // quadratic potential: K = d(dL/dq)/dq is constant, found at construction),
   //     dL/dq(q_c) = dL/dq(q_c,guess) + c K (q_next - q_guess),  q_next - q_guess = h (v - v_guess)
   // exactly, and the first line of eq. (6) is
   //     (M - h^2 kappa K) v = rhs - h^2 kappa K v_guess - omega(q_{k+1})^T lambda:
   // the passes use P = (M - h^2 kappa K)^-1 (kept for the last two step sizes:
-  // the triple jump and Suzuki's composition alternate between two, and with
-  // one kept the particle's midpoint triple jump cost 469-487 ns per step,
-  // with two 394, in a scratch run)
+  // the triple jump and Suzuki's composition alternate between two)
   // instead of V(qbar, .) = M^-1, and are then exact in the potential, so
-  // the particle's settle like the symmetric rule's (h = 0.2: Newton
-  // iterations 1.89 -> 0.004 per step).  At a fixed point the added terms
-  // cancel (v = v_guess): it is still the step's solution.  With a
+  // the particle's settle like the symmetric rule's.  At a fixed point the
+  // added terms cancel (v = v_guess): it is still the step's solution.  With a
   // non-quadratic potential the same passes with K taken once per step (one
-  // Jet evaluation) contracted by only ~200 per pass on the robot and ~1e3 on
-  // the contact oscillator, did not settle in kMinPasses, and made the steps
-  // slower (robot 610 -> 720 ns, chaotic oscillator 850 -> 1430 ns): those
-  // systems keep the passes above, as do kappa = 0 and K = 0.
+  // Jet evaluation) contract too little to settle in kMinPasses, and the Jet
+  // costs more than the passes save: those systems keep the passes above, as
+  // do kappa = 0 and K = 0.
   //   Except a potential of one coordinate r (dL/dq reads q_r alone, found by
   // autodiff at construction: the robot's V0 sin psi).  Then K = d(dL/dq)/dq
   // has one column, and every pass takes it at the nodes by a Jet of one
@@ -474,22 +375,20 @@ class DlaStepper {
   // system (M - u e_r^T) v = ..., Omega v = 0 (u = h^2 sum_c w_c c (1 - c) K e_r):
   // a Newton step in the potential, so the passes converge quadratically, the
   // third is at round-off and the residual check confirms it (kNewtonPasses).
-  // (Until 77a1b51 by Sherman-Morrison on (M - u e_r^T)^-1 and an m x m
-  // inverse after the curvature at every pass; since, through the constrained
-  // inverse Pi of M, taken only when Omega changes: run_passes.)
-  // Measured in one run at h = 0.2 on the robot, Sherman-Morrison form
-  // (ns per step, before -> after):
-  // midpoint rule 525-552 -> 414-415 (Newton iterations 1.79 -> 0.007),
-  // alpha = 1/4 521-580 -> 423-425, symmetric alpha = 1/4 721-742 -> 553-559.
-  // (The same with the curvature of every coordinate, a Jet of n derivatives
-  // and an n x n inverse per pass, removed the iterations too but made the
-  // robot's step slower, 701 -> 821 ns, and the contact oscillator's 313 -> 580.)
+  // The pass solves through the constrained inverse Pi of M, taken again only
+  // when Omega changes (run_passes).  (The curvature of every coordinate, a
+  // Jet of n derivatives and an n x n inverse per pass, would remove the
+  // iterations too, but costs more per step than they do.)
   // extend: Newton passes (a potential of one coordinate) may add passes, up
   // to kMaxNewtonPasses, while the last one moved by more than sqrt(eps) of
-  // the state's size (the stepper's own calls; at h = 0.4 three were often
+  // the state's size (the stepper's own calls; at h = 0.4 three are often
   // not enough).
   void next_guess(double h, VecN* q_guess, VecM* lambda_guess, int passes, bool* settled = nullptr,
-                  bool extend = false) const {
+                  bool extend = false) const;
+
+ private:
+  // next_guess's body, inline so that step() compiles it in place.
+  void predict(double h, VecN* q_guess, VecM* lambda_guess, int passes, bool* settled, bool extend) const {
     if (settled) *settled = false;
     polish_ok_ = false;
     if (steps_ == 0) {
@@ -524,10 +423,7 @@ class DlaStepper {
     if constexpr (kPassesSolveMultipliers) {
       // Only where a plain pass gains less than 10^6 (its factor is about
       // rho = h^2 kappa |M^-1 K|): below, two plain passes reach round-off
-      // from the extrapolation and P would only cost (particle, midpoint
-      // rule: h = 0.4 / 2^9, rho = 3e-7, 190-215 ns per step either way;
-      // h = 0.4 / 2^8, rho = 1.2e-6, plain passes needed a Jet on 32 % of the
-      // steps, 284 -> 194 ns with P).
+      // from the extrapolation and P would only cost.
       if (K_) {
         curv_.at(h, [this](double hh) {
           Curvature c;
@@ -555,10 +451,12 @@ class DlaStepper {
     }
   }
 
+ public:
+
   // The passes of next_guess; kNewton: with the curvature of a potential of
   // one coordinate (a separate instantiation, so that the other passes
-  // compile as they did without it: a runtime branch in one loop made the
-  // particle's and the contact oscillator's steps 7-45 % slower).
+  // compile without it: a runtime branch in one shared loop makes the
+  // particle's and the contact oscillator's steps slower).
   template <bool kNewton>
   void run_passes(double h, int passes, bool extend, bool curved, double cbar, double inv_h,
                   const Mat<double, n, Map::mc>& PWt, VecN* q_guess, VecM* lambda_guess, bool* settled) const {
@@ -642,8 +540,7 @@ class DlaStepper {
           // first pass is then exact in every coordinate, not the second, and
           // with kappa = 0 the stepper makes one pass before the residual
           // check (gs_, step()).  Kept to kappa = 0: on every plain pass it
-          // made the contact oscillator's midpoint DLA slower (the
-          // measurements: experiments/speed_log.md, "What made steps faster", d67faed/525ba90).
+          // makes the contact oscillator's midpoint DLA slower.
           vfree = velocity<S, double>(sys, qbar, rhs);
           for (int i = 0; i < n; ++i)
             if ((VWt.row(i).array() == 0.0).all()) (*q_guess)[i] = q[i] + h * vfree[i];
@@ -666,10 +563,8 @@ class DlaStepper {
           // lambda = S0 Omega M^-1 x, S0 = (Omega M^-1 W^T)^-1,
           // Pi = M^-1 - M^-1 W^T S0 Omega M^-1; its row r gives
           // v_r = (Pi rhs')_r / (1 - (Pi u)_r).  The same system as the
-          // Sherman-Morrison form (before 77a1b51), which took (Omega G W^T)^-1
-          // after the curvature at every pass: measured side by side on the robot's
-          // midpoint rule at h = 0.2 (scratch loop, best of 40 x 10^5 steps,
-          // four rounds) 299-305 -> 280-286 ns per step.
+          // Sherman-Morrison form above, without taking (Omega G W^T)^-1
+          // after the curvature at every pass.
           if (!pi_ready || !(Om.array() == pi_Om.array()).all()) {
             pi_Om = Om;
             pi_S0 = Mat<double, m, m>(Om * MWt).inverse();
@@ -728,8 +623,8 @@ class DlaStepper {
 
   // The correction of a guess the residual check accepted by its second test
   // (NewtonSolver::solve: at small h; where the first test, against the terms
-  // alone, accepts, the mean correction below measured 0.15-0.17 eps |q|_inf,
-  // a correctly rounded step, without it), from its residual r = (r_f, r_g):
+  // alone, accepts, the guess is a correctly rounded step without it), from
+  // its residual r = (r_f, r_g):
   // one chord Newton step with the step matrix (7) taken as
   // [-G^-1/h  -W^T; Omega/h  0], G = M^-1 (or P, see next_guess) and Omega
   // the last pass's constraint form, i.e. the matrices of that pass:
@@ -738,10 +633,10 @@ class DlaStepper {
   // The check accepts a point up to 16 eps of its scale from the zero of the
   // residual, and at small h that scale holds |q|/h (solver.hpp), so a guess
   // that is the passes' fixed point, or a pass short of it, could be a few
-  // eps |q| off, smoothly from step to step.  That drifted: the contact
-  // oscillator's midpoint rule at h = 0.4/2^8 moved its mean energy error by
-  // 7.5e-9 (1.7 %) over 2e6 steps against a long-double solve of the same
-  // steps, Newton alone by 1.7e-11; with this correction by 1.3e-10 (issue 13).
+  // eps |q| off, smoothly from step to step, and such offsets add up to a
+  // drift of the mean energy error over long runs (the contact oscillator's
+  // midpoint rule at small h) that Newton alone does not have
+  // (tests/test_dla.cpp).
   // The correction's fixed point is the zero of the residual, and from a
   // point already at round-off it moves by round-off, so it is taken without
   // another residual.
@@ -783,30 +678,14 @@ class DlaStepper {
   // what omega reads (constraint_force_misses_omega), so the multipliers'
   // start does not matter and the passes settle as in one direction.  The
   // triple jump's stages then take no Newton iteration where the passes see
-  // the potential (the particle, the robot, the symmetric rule), instead of
-  // ~3 each, and fewer elsewhere (the oscillators' midpoint rule: 9.7 -> 5.6
-  // and 10.2 -> 6.3 per composed step) (measured in one scratch run at h = 0.2, ns per composed step, before ->
-  // after: particle midpoint 837-913 -> 453-466, symmetric 1089-1095 ->
-  // 406-411; robot midpoint 1833-1905 -> 986-987, symmetric 1505-1532 ->
-  // 872-874; contact oscillator 892-931 -> 665-670 and 1042-1061 -> 324-330;
-  // chaotic oscillator 4022-4185 -> 2446-2463 and 5442-5516 -> 529-536).  On
-  // the sleigh (omega reads theta, the force turns it) the passes at a turn
-  // made its triple jump slower (midpoint 359-387 -> 542-562 ns): there the
-  // stages keep the plain extrapolation.  (Refining at a turn
-  // had once cost the robot's triple jump 4.1 iterations per stage, with the
-  // passes before those that are Newton steps in its potential.)
+  // the potential (the particle, the robot, the symmetric rule), and fewer
+  // elsewhere.  On the sleigh (omega reads theta, the force turns it) the
+  // passes at a turn cost more than they save: there the stages keep the
+  // plain extrapolation.
   bool refines(double h) const { return one_direction(h) || (passes_settle_ && steps_ >= 2); }
 
   // Point k = steps - 1: (q_k, v_k, p_k, lambda_k, omega_d(q_k, q_{k+1})).
-  void sample(Sample<n, m>* s) const {
-    s->has_p = true;
-    s->q = q_curr_;
-    s->v = steps_ == 1 ? v0_ : VecN((q_next_ - q_prev_) / (h_prev_ + h_));
-    s->p = p_curr_;
-    s->lambda = lambda_.template head<m>();
-    s->discrete_constraint = discrete_constraint<S, D, double>(map_.system(), map_.discretization(), h_,
-                                                               q_curr_, q_next_);
-  }
+  void sample(Sample<n, m>* s) const;
 
   // The newest point (q_{k+1}, p_{k+1}) and the last multipliers.
   Vec<double, 2 * n> phase() const {

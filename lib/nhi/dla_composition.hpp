@@ -1,4 +1,4 @@
-// The paper's DLA composed (issue 11, question 4): the variable-step DLA
+// The paper's DLA composed: the variable-step DLA
 //     D2 L_d^{h_{k-1}}(q_{k-1}, q_k) + D1 L_d^{h_k}(q_k, q_{k+1}) = omega(q_k)^T lambda_k   (eq. 6)
 // with h_k cycling through the stage steps gamma_i h of a composition
 // (composition.hpp).  The DLA is not self-adjoint on T*Q (the constraint force
@@ -8,7 +8,7 @@
 // discretization (alpha = 1/2, the symmetric family) that map is self-adjoint:
 // a step of h then -h returns q and p mod omega^T.  Composition then raises its
 // order like any symmetric method's: measured 4 for the triple jump on both
-// paper scenes (tests/test_dla_composition.cpp, README "The paper's DLA composed").
+// paper scenes (tests/test_dla_composition.cpp, README "Methods").
 //
 // Reported per full step h: q_k, p_k = D2 L_d of the last stage, and the velocity
 // of the class of p_k that lies in the constraint distribution,

@@ -95,13 +95,13 @@ inline Mat<double, S::n, S::n> inverse_mass_matrix(const S& sys) {
 // V(q, p) = M^-1 p of a separable system, with M^-1 formed once (by
 // inverse_mass_matrix) and applied by products; a stepper keeps one for its
 // system.  A hand-written V may divide by the masses (the robot, the sleigh),
-// and on the robot's explicit mp06 step those divisions were a fifth of the
-// step (issue 13).  A diagonal M^-1 is applied entry by entry, p_i (M^-1)_ii;
+// and divisions are slow against the rest of an explicit mp06 step.  A
+// diagonal M^-1 is applied entry by entry, p_i (M^-1)_ii;
 // the products differ from a V that divides at round-off.  Where M^-1 is the
 // identity (every scene's default), identity() says so and a stepper uses
 // IdentityVelocity below instead: p itself, which is V bit for bit, with no
-// test of a flag inside the step (testing one on every V cost the
-// particle's 27 ns mp06 step 5-7 ns in scratch runs).
+// test of a flag inside the step (testing one on every V is a noticeable
+// share of the particle's cheap mp06 step).
 template <class S>
 class SeparableVelocity {
  public:

@@ -14,9 +14,6 @@
 #include <type_traits>
 #include <utility>
 
-#include "nhi/dla.hpp"
-#include "nhi/reference.hpp"
-#include "nhi/rk4.hpp"
 #include "nhi/stepper.hpp"
 
 namespace nhi {
@@ -67,21 +64,6 @@ template <class Stepper, class Observer, class = std::enable_if_t<!std::is_lvalu
 RunReport integrate(Stepper&& stepper, const Vec<double, std::decay_t<Stepper>::n>& q0,
                     const Vec<double, std::decay_t<Stepper>::n>& v0, double h, long steps, Observer&& observe) {
   return integrate(stepper, q0, v0, h, steps, std::forward<Observer>(observe));
-}
-
-// q(T) and v(T) of the reference solution from (q0, v0) at rtol = atol = tol.
-template <class S>
-void reference_solution(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T,
-                        double tol, Vec<double, S::n>* qT, Vec<double, S::n>* vT = nullptr) {
-  ReferenceOptions opt;
-  opt.rtol = opt.atol = tol;
-  *qT = q0;
-  if (vT) *vT = v0;
-  integrate(ReferenceStepper<S>(sys, opt), q0, v0, T, 1, [&](const Sample<S::n, S::m>& s) {
-    *qT = s.q;
-    if (vT) *vT = s.v;
-    return true;
-  });
 }
 
 }  // namespace nhi

@@ -25,6 +25,8 @@
 #include "nhi/discrete_gradient.hpp"
 #include "nhi/dla_composition.hpp"
 #include "nhi/integrate.hpp"
+#include "nhi/reference.hpp"
+#include "nhi/rk4.hpp"
 #include "nhi/method_spec.hpp"
 #include "nhi/mp06.hpp"
 #include "nhi/run.hpp"
@@ -37,7 +39,7 @@ struct DlaMethod {
   static constexpr bool uses_discretization = true;
   static constexpr bool reports_p = true;
   // Self-adjoint discretizations (alpha = 1/2, the symmetric family) compose:
-  // dla_composition.hpp, README "The paper's DLA composed".
+  // dla_composition.hpp, README "Methods".
   static bool symmetric(const MethodSpec& spec) {
     return spec.discretization == "symmetric" || (spec.discretization == "alpha" && spec.alpha == 0.5);
   }

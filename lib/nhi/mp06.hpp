@@ -20,7 +20,7 @@
 //  - separable systems (L = 1/2 v^T M v - U(q), M constant): F does not depend
 //    on p and V not on q, so p1 and q1 are explicit, affine in lambda, and the
 //    step is m equations omega(q1(lambda)) V(p1(lambda)) = 0 in lambda alone.
-// tests/test_new_methods.cpp checks that the three forms give the same step,
+// tests/test_mp06.cpp checks that the three forms give the same step,
 // and the separable one against a closed-form step of the particle.
 #pragma once
 
@@ -56,7 +56,7 @@ void mp06_constraint_rows(const Mat<T, m, n>& W1, const Vec<T, n>& v1, int first
 
 // Phase form, the equations as stated: y = (q1, p1), lambda; rows (q
 // equation, p equation, constraint).  The stepper solves the velocity form
-// below; tests/test_new_methods.cpp checks that the two give the same step.
+// below; tests/test_mp06.cpp checks that the two give the same step.
 template <class S>
 struct Mp06PhaseProblem {
   static constexpr int n = S::n, m = S::m;
@@ -133,9 +133,9 @@ struct Mp06PhaseProblem {
 // the saddle-point form of NewtonSolver with the fixed Wt = h omega(q_half)^T,
 // as the DLA's (dla.hpp).  n unknowns y instead of the phase form's 2n, so Jets of n
 // derivatives instead of 2n and, for n, m <= 4, the closed-form Schur solve
-// instead of pivoted LU of the whole matrix (issue 13: on
-// contact_oscillator_nr perf put 23 % of a step in that LU and 40 % in the
-// Jet evaluation).  The unknown is v1, not q1: with q1, v1 = 2 (q1 - q_half) / h
+// instead of pivoted LU of the whole matrix (on contact_oscillator_nr that
+// LU and the Jet evaluation are most of the phase form's step).  The
+// unknown is v1, not q1: with q1, v1 = 2 (q1 - q_half) / h
 // would carry the round-off of q1 times 2/h into p1 and lambda at small h.
 template <class S>
 struct Mp06Problem {
@@ -187,11 +187,10 @@ struct Mp06Problem {
   // explicit pass: p1 from the momentum equation, with F at the Legendre
   // momentum dL/dqdot(qv, v1), then q1 = q_half + (h/2) V(qv, p1), where
   // qv = q_half + (h/2) v1 is the velocity form's q1.  Changes
-  // of round-off size, but taking p1 = dL/dqdot(q1, v1) itself biased the
-  // energy: on contact_oscillator_nr, mp06 + order 6 at h = 0.0125 drifted by
-  // 1.2e-10 over t = 1000 against 7.6e-13 for the phase form's solve, and
-  // 6.0e-13 with this pass (tests/test_new_methods.cpp,
-  // Mp06.VelocityFormKeepsThePhaseFormEnergyRoundOff).
+  // of round-off size, but taking p1 = dL/dqdot(q1, v1) itself biases the
+  // energy (contact_oscillator_nr, mp06 + order 6 at small h); with this pass
+  // the energy drifts no more than with the phase form's solve
+  // (tests/test_mp06.cpp, Mp06.VelocityFormKeepsThePhaseFormEnergyRoundOff).
   void finish(const Vec<double, ny>& v1, const Vec<double, nl>& lambda, VecN* q1, VecN* p1) const {
     const VecN qv = q_half + 0.5 * h * v1;
     *p1 = p0 + 0.5 * h * (F0 + force<S, double>(sys, q_half, momentum(sys, qv, v1))) + W_t * lambda;
@@ -252,15 +251,15 @@ struct Mp06SeparableProblem {
   // its derivative in lambda, of size h^2 |M^-1 omega^T|, does not show: on
   // the sleigh running straight at theta ~ 3.09, sin(theta) ~ 0.05 takes
   // theta's last bit (~4e-16) as a relative error of ~1e-14 while the row's
-  // two terms (0.087 each) cancel, and a start from the last multiplier sat
-  // at 20 eps of the terms, above newton()'s 16 eps: one iteration a stage
-  // that could not improve it (Suzuki 5's stages 4 and 5; issue 13).
+  // two terms (0.087 each) cancel, so a start from the last multiplier can
+  // sit at ~20 eps of the terms, above newton()'s 16 eps, and without these
+  // terms would cost an iteration a stage that cannot improve it (Suzuki 5's
+  // stages 4 and 5; tests/test_mp06.cpp, Mp06.SleighResidualFloorIsTheRoundingOfQ1).
   //   Only the coordinates the multiplier moves count (V(h omega(q_half)^T
   // e_a)_k != 0 for some a): one it does not move is a fixed input of the
   // solve, like q_half, whose rounding Newton can solve around, and counting
-  // it would accept residuals far from round-off (a review's scratch system,
-  // omega reading such a coordinate of size 6e6: accepted at 16000 eps of
-  // the terms against 55 without).  Where the step is explicit none counts.
+  // it would accept residuals far from round-off (where omega reads such a
+  // coordinate and it is large).  Where the step is explicit none counts.
   //   The rounding of p1 is left out: V is linear in p, so with a diagonal
   // M^-1 it is that of v1, which the terms |omega_aj v1_j| already are
   // (with a non-diagonal one it is not covered: the test is then stricter,
@@ -292,55 +291,28 @@ struct Mp06SeparableProblem {
   }
 };
 
-// The stateful mp06 stepper (stepper.hpp), lag 0.  kSeparable selects the
-// reduced solve (default: when the system declares it separable).
-template <class S, bool kSeparable = is_separable<S>::value>
+// The stateful mp06 stepper (stepper.hpp), lag 0.  kSeparableForm asks for
+// the reduced solve (default: when the system declares it separable); it
+// applies only where the system is separable (kSeparable), so that both forms
+// exist for every system and the library compiles both.  The bodies of the
+// members that solve or differentiate (the constructor, explicit_structure,
+// start, map, step, sample, phase) are in mp06_body.hpp.
+template <class S, bool kSeparableForm = is_separable<S>::value>
 class Mp06Stepper {
  public:
+  static constexpr bool kSeparable = kSeparableForm && is_separable<S>::value;
   static constexpr int n = S::n, m = S::m;
   static constexpr int lag = 0;
   using VecN = Vec<double, n>;
   using VecM = Vec<double, m>;
 
   // allow_explicit = false always solves by Newton (tests compare the two).
-  explicit Mp06Stepper(const S& sys, SolverOptions options = {}, bool allow_explicit = true)
-      : sys_(sys), vel_(sys), options_(options), explicit_(allow_explicit && explicit_structure(sys)) {}
+  explicit Mp06Stepper(const S& sys, SolverOptions options = {}, bool allow_explicit = true);
   const S& system() const { return sys_; }
 
-  // Is the step explicit?  For a separable system, q1 = q_half + (h/2) V(p_base
-  // + h omega(q_half)^T lambda), and when the rows of omega depend only on
-  // coordinates whose velocities the constraint force does not change (the
-  // particle: omega depends on y, the force acts on x and z; the robot: on
-  // theta, the force on x, y, psi; the contact and chaotic oscillators; the
-  // knife edge), omega(q1) does not depend on lambda and the constraint
-  // omega(q1) V(p1) = 0 is linear in lambda: one m x m solve.  Detected by
-  // autodiff: d omega(q1(lambda)) / d lambda is exactly zero (a structural
-  // zero, not a small number) at two unrelated states.
-  static bool explicit_structure(const S& sys) {
-    if constexpr (!kSeparable) {
-      return false;
-    } else {
-      using J = ceres::Jet<double, m>;
-      for (int probe = 0; probe < 2; ++probe) {
-        VecN q0, p0;
-        for (int i = 0; i < n; ++i) {
-          q0[i] = probe_q(i, probe);
-          p0[i] = probe_v(i, probe);
-        }
-        const SeparableVelocity<S> vel(sys);
-        const Mp06SeparableProblem<S> prob(sys, vel, 0.3, q0, p0);
-        Vec<J, m> lj;
-        for (int a = 0; a < m; ++a) lj[a] = J(0.1 * (a + 1), a);
-        Vec<J, n> q1, p1, v1;
-        prob.template state<J>(lj, &q1, &p1, &v1);
-        const Mat<J, m, n> W1 = sys.template omega<J>(q1);
-        for (int a = 0; a < m; ++a)
-          for (int j = 0; j < n; ++j)
-            if (!(W1(a, j).v.array() == 0.0).all()) return false;
-      }
-      return true;
-    }
-  }
+  // Is the step explicit (one m x m solve in lambda)?  Found by autodiff at two
+  // states; the reasoning is at the definition (mp06_body.hpp).
+  static bool explicit_structure(const S& sys);
   bool is_explicit() const { return explicit_; }
 
   MethodTraits traits() const {
@@ -354,12 +326,7 @@ class Mp06Stepper {
   }
 
   // Start from p0 = dL/dqdot(q0, v0).
-  void start(const VecN& q0, const VecN& v0) {
-    q_ = q0;
-    p_ = momentum(sys_, q0, v0);
-    lambda_ = VecM::Zero();
-    steps_ = 0;
-  }
+  void start(const VecN& q0, const VecN& v0);
 
   // On a separable system Newton's only unknown is the multiplier (the
   // explicit step, where it applies, needs no start at all), so the
@@ -369,25 +336,11 @@ class Mp06Stepper {
   void guess_lambda(const VecM& l) { lambda_ = l; }
 
   // One step (q0, p0) -> (q1, p1) of size h; lambda holds the starting guess and gets the multiplier.
-  StepSummary map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecM* lambda) const {
-    StepSummary s;
-    if constexpr (kSeparable) {
-      // One test per step picks V (SeparableVelocity in hamiltonian.hpp).
-      if (vel_.identity()) return map_separable(IdentityVelocity{}, h, q0, p0, q1, p1, lambda);
-      return map_separable(vel_, h, q0, p0, q1, p1, lambda);
-    } else {
-      const Mp06Problem<S> prob(sys_, h, q0, p0);
-      Vec<double, n> y = prob.guess(q0, *lambda);
-      VecM l = *lambda;
-      s = NewtonSolver<Mp06Problem<S>>(prob, options_).solve(&y, &l);
-      if (s.ok()) {
-        prob.finish(y, l, q1, p1);
-        *lambda = l;
-      }
-    }
-    return s;
-  }
+  StepSummary map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecM* lambda) const;
 
+  // map()'s separable form and its explicit solve, called only from map():
+  // member templates, which an explicit instantiation of the class does not
+  // compile, so they stay defined here and are compiled where map() is.
   template <class Velocity>
   StepSummary map_separable(const Velocity& V, double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1,
                             VecM* lambda) const {
@@ -455,43 +408,14 @@ class Mp06Stepper {
     return true;
   }
 
-  StepSummary step(double h) {
-    VecN q1, p1;
-    VecM lambda = lambda_;
-    StepSummary s = map(h, q_, p_, &q1, &p1, &lambda);
-    ++steps_;
-    if (s.ok() && !(all_finite(q1) && all_finite(p1))) {
-      s.status = SolveStatus::kFailed;
-      s.failure = FailureKind::kNonFinite;
-      s.message = "non-finite state";
-    }
-    if (!s.ok()) {
-      s.message = "mp06 step " + std::to_string(steps_) + " did not converge: " + s.message;
-      return s;
-    }
-    q_ = q1;
-    p_ = p1;
-    lambda_ = lambda;
-    return s;
-  }
+  StepSummary step(double h);
 
   // Point k: q_k, v_k = V(q_k, p_k) (omega(q_k) v_k = 0 to round-off), p_k, the
   // multiplier of the step that arrived at k (0 at k = 0), and omega(q_k) v_k
   // as the constraint the method holds.
-  void sample(Sample<n, m>* s) const {
-    s->has_p = true;
-    s->q = q_;
-    s->v = velocity<S, double>(sys_, q_, p_);
-    s->p = p_;
-    s->lambda = lambda_;
-    s->discrete_constraint = sys_.template omega<double>(q_) * s->v;
-  }
+  void sample(Sample<n, m>* s) const;
 
-  Vec<double, 2 * n> phase() const {
-    Vec<double, 2 * n> z;
-    z << q_, p_;
-    return z;
-  }
+  Vec<double, 2 * n> phase() const;
   const VecM& lambda() const { return lambda_; }
 
  private:

@@ -12,7 +12,8 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "nhi/integrate.hpp"
+#include "nhi/stepper.hpp"
+#include "nhi/system.hpp"
 
 namespace nhi {
 

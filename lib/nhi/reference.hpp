@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "nhi/integrate.hpp"
 #include "nhi/stepper.hpp"
 #include "nhi/system.hpp"
 
@@ -147,34 +148,9 @@ class ReferenceStepper {
     return t;
   }
 
-  void start(const VecN& q0, const VecN& v0) {
-    cv_ = std::make_unique<CvodeReference<S>>(sys_, 0.0, q0, v0, opt_);
-    q_ = q0;
-    v_ = v0;
-    k_ = 0;
-    rhs_ = steps_ = 0;
-  }
+  void start(const VecN& q0, const VecN& v0);
 
-  StepSummary step(double h) {
-    StepSummary s;
-    const bool ok = cv_->advance((k_ + 1) * h, &q_, &v_);
-    ++k_;
-    const long rhs = cv_->rhs_evaluations(), internal = cv_->internal_steps();
-    s.rhs_evaluations = rhs - rhs_;
-    s.internal_steps = internal - steps_;
-    rhs_ = rhs;
-    steps_ = internal;
-    if (!ok) {
-      s.failure = FailureKind::kSolve;
-      s.message = "CVODE failed: " + cv_->message();
-    } else if (!all_finite(q_) || !all_finite(v_)) {
-      s.failure = FailureKind::kNonFinite;
-      s.message = "state became non-finite at step " + std::to_string(k_);
-    } else {
-      s.status = SolveStatus::kConverged;
-    }
-    return s;
-  }
+  StepSummary step(double h);
 
   void sample(Sample<n, m>* s) const {
     s->q = q_;
@@ -193,5 +169,20 @@ class ReferenceStepper {
   VecN q_ = VecN::Zero(), v_ = VecN::Zero();
   long k_ = 0, rhs_ = 0, steps_ = 0;
 };
+
+// q(T) and v(T) of the reference solution from (q0, v0) at rtol = atol = tol.
+template <class S>
+void reference_solution(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T,
+                        double tol, Vec<double, S::n>* qT, Vec<double, S::n>* vT = nullptr) {
+  ReferenceOptions opt;
+  opt.rtol = opt.atol = tol;
+  *qT = q0;
+  if (vT) *vT = v0;
+  integrate(ReferenceStepper<S>(sys, opt), q0, v0, T, 1, [&](const Sample<S::n, S::m>& s) {
+    *qT = s.q;
+    if (vT) *vT = s.v;
+    return true;
+  });
+}
 
 }  // namespace nhi

@@ -1,10 +1,10 @@
 // Scenes in, results out: the JSON contract of the `nhi` runner.
 //
 // A scene is a JSON object with the keys
-//   system         "particle" | "robot"                         (required)
+//   system         a registered system's name (nhi list)      (required)
 //   params         object of system parameters                  (default: the system's)
 //   q0, v0         arrays of n numbers; v0 must satisfy omega(q0) v0 = 0   (required)
-//   method         "dla" | "rk4" | "benchmark" | "mp06" | "discrete_gradient"   (required)
+//   method         a method's name (nhi list): "dla", "rk4", "benchmark", ...  (required)
 //   composition    "none" | "triple_jump" | "suzuki5" | "order6"  (default "none");
 //                  anything but "none" only with a symmetric method: mp06,
 //                  discrete_gradient, dla with alpha 0.5 or discretization "symmetric"
@@ -35,6 +35,17 @@ using json = nlohmann::json;
 struct SceneError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// What the library has, for `nhi list`: {"systems": [{name, n, m, params
+// (name: default), q0, v0, reversible, separable}], "methods": [{label,
+// method, discretization, alpha, composition, order, symmetric, implicit,
+// adaptive, composable, group}] (every method the studies run), "compositions":
+// [{name, order, stages}]}.
+json catalog();
+
+// The deepest nesting of arrays and objects a scene or a --set value may have
+// (a scene needs 3); deeper input is refused while it is parsed.
+constexpr int kMaxSceneDepth = 64;
 
 // Parse a scene file (throws SceneError on unreadable or malformed JSON).
 json load_scene_file(const std::string& path);

@@ -178,7 +178,7 @@ class NewtonSolver {
   // the scale of the point whose Jacobian the chord iterations use: near the
   // solution the sizes of the terms change by the relative size of the step,
   // which does not matter to a threshold, and skipping them halves the cost of
-  // a residual (issue 13).
+  // a residual.
   double evaluate_value(const VecY& y, const VecL& lambda, const VecX& scale, VecX* r) const {
     p_.template residual<double>(y, lambda, r, nullptr);
     double rel = 0;
@@ -202,9 +202,8 @@ class NewtonSolver {
   // +y_scale serves the rows of f (for the DLA, ~ -M/h); a row of g that still
   // fails gets one along the signs of its multiplier's column of Wt (for the
   // DLA, d omega_d/dq1 ~ omega/h and Wt = omega(q_k)^T), which do not cancel.
-  // (Issue 13: at h = 0.4 / 2^9 the first test failed on 99-100 % of the
-  // symmetric DLA's steps, and each then paid a Jet evaluation for zero
-  // iterations.)
+  // (At h = 0.4 / 2^9 the first test alone fails on almost every step of the
+  // symmetric DLA, and each would pay a Jet evaluation for zero iterations.)
   // *r_out (optional) gets the residual of an accepted guess, and *by_bound
   // whether it took the second test.
   bool guess_converged(const VecY& y, const VecL& lambda, Summary* s, VecX* r_out = nullptr,
@@ -251,7 +250,7 @@ class NewtonSolver {
     return true;
   }
 
-  // x^k for a small fixed k (std::pow was a tenth of a DLA step).
+  // x^k for a small fixed k (std::pow would be a noticeable share of a DLA step).
   template <int k>
   static double power(double x) {
     double p = 1;
@@ -326,12 +325,10 @@ class NewtonSolver {
   // evaluation paid the Jacobian for (no new evaluation; not counted as an
   // iteration, like DlaStepper::polish): otherwise an accepted start keeps
   // its error, and where the solution moves by round-off from step to step
-  // the residual of the next start creeps past the round-off test.  Issue 13:
-  // mp06 on the sleigh, where lambda = 0 while it runs straight, took one
-  // iteration on 467 of 1000 steps from the default start at h = 0.2 (the
-  // residual of the last multiplier growing by ~2e-16 a step until it passed
-  // 16 eps of its scale) and 142 with the update; 1.62 -> 1.30 evaluations
-  // per step.
+  // the residual of the next start creeps past the round-off test (mp06 on
+  // the sleigh, where lambda = 0 while it runs straight: without the update
+  // the residual of the last multiplier grows by ~2e-16 a step until it
+  // passes 16 eps of its scale, and an iteration follows).
   Summary newton(VecY* y_io, VecL* lambda_io) const {
     constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
     Summary s;

@@ -126,6 +126,50 @@ void refuse_if_too_large(const json& r, int n, int m, int first_integrals) {
 
 std::vector<std::string> system_names() { return registered_system_names(); }
 
+json catalog() {
+  json out;
+  out["systems"] = json::array();
+  for_each_type(Systems{}, [&](auto tag) {
+    using S = typename decltype(tag)::type;
+    const S sys;
+    json params = json::object();
+    for (const auto& p : S::parameters()) params[p.name] = sys.*(p.member);
+    const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
+    out["systems"].push_back({{"name", S::name},
+                              {"n", S::n},
+                              {"m", S::m},
+                              {"params", params},
+                              {"q0", std::vector<double>(q0.data(), q0.data() + S::n)},
+                              {"v0", std::vector<double>(v0.data(), v0.data() + S::n)},
+                              {"reversible", is_reversible<S>::value},
+                              {"separable", is_separable<S>::value}});
+  });
+  // Every method the studies run, with the traits it declares (on the first
+  // registered system: a method's order and symmetry do not depend on it).
+  using First = typename At<Systems, 0>::type;
+  out["methods"] = json::array();
+  for (const StudyMethod& m : study_methods()) {
+    if (m.external) continue;
+    const MethodTraits t = method_traits(First{}, m.spec);
+    out["methods"].push_back({{"label", m.label()},
+                              {"method", m.spec.kind},
+                              {"discretization", method_flags(m.spec.kind).uses_discretization
+                                                     ? json(m.spec.discretization) : json(nullptr)},
+                              {"alpha", method_flags(m.spec.kind).uses_discretization ? json(m.spec.alpha) : json(nullptr)},
+                              {"composition", m.spec.composition},
+                              {"order", t.order},
+                              {"symmetric", t.symmetric},
+                              {"implicit", t.implicit},
+                              {"adaptive", t.adaptive},
+                              {"composable", m.spec.composition == "none" && method_is_symmetric(m.spec)},
+                              {"group", m.group}});
+  }
+  out["compositions"] = json::array();
+  for (const Composition& c : compositions())
+    out["compositions"].push_back({{"name", c.name}, {"order", c.order}, {"stages", c.gamma.size()}});
+  return out;
+}
+
 json load_scene_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw SceneError("cannot read scene file '" + path + "'");
@@ -134,9 +178,24 @@ json load_scene_file(const std::string& path) {
   return parse_scene_text(ss.str(), "scene file '" + path + "'");
 }
 
+namespace {
+
+// json::parse, refusing values nested deeper than kMaxSceneDepth before they
+// are built (printing or walking a value nested 10^5 deep overflows the stack).
+json parse_bounded(const std::string& text, const std::string& what) {
+  const json::parser_callback_t bound = [&what](int depth, json::parse_event_t, json&) {
+    if (depth > kMaxSceneDepth)
+      throw SceneError(what + " is nested deeper than " + std::to_string(kMaxSceneDepth) + " levels");
+    return true;
+  };
+  return json::parse(text, bound);
+}
+
+}  // namespace
+
 json parse_scene_text(const std::string& text, const std::string& origin) {
   try {
-    return json::parse(text);
+    return parse_bounded(text, origin);
   } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
     throw SceneError(origin + " is not valid JSON: " + e.what());
   }
@@ -149,7 +208,7 @@ void apply_override(json* scene, const std::string& assignment) {
   const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
   json value;
   try {
-    value = json::parse(text);
+    value = parse_bounded(text, "--set " + key);
   } catch (const json::parse_error&) {
     value = text;
   } catch (const json::exception& e) {  // out_of_range: a number like 1e999 (found by make fuzz)

@@ -1,11 +1,18 @@
 // Compiled once per registered system (CMakeLists.txt builds it with
-// NHI_SYSTEM_SLOT = 0, 1, ..., NHI_SYSTEM_SLOTS - 1): the definitions of
-// run.hpp for the system at that position of `Systems`.  Splitting by system
-// lets the two cores build the method instantiations in parallel, once.
+// NHI_SYSTEM_SLOT = 0, 1, ..., NHI_SYSTEM_SLOTS - 1): every stepper of the
+// system at that position of `Systems`, explicitly instantiated, and the
+// definitions of run.hpp for it.  Code that includes only the steppers' light
+// headers (dla.hpp, mp06.hpp, ...) links to these instances instead of
+// compiling the step machinery again; one file per system lets the cores
+// build them in parallel.
 #include <type_traits>
 #include <utility>
 
+#include "nhi/discrete_gradient_body.hpp"
+#include "nhi/dla_body.hpp"
 #include "nhi/methods.hpp"
+#include "nhi/mp06_body.hpp"
+#include "nhi/reference_body.hpp"
 #include "nhi/run.hpp"
 #include "nhi/systems/registry.hpp"
 
@@ -58,6 +65,13 @@ std::unique_ptr<AnyStepper<S::n, S::m>> make_stepper(const S& sys, const MethodS
 
 #if NHI_SYSTEM_SLOT < NHI_SYSTEM_SLOTS
 using SlotSystem = typename At<Systems, NHI_SYSTEM_SLOT>::type;
+template class DlaStepper<SlotSystem, AlphaDiscretization>;
+template class DlaStepper<SlotSystem, SymmetricDiscretization>;
+template class DlaStepper<SlotSystem, SplitDiscretization>;
+template class Mp06Stepper<SlotSystem, true>;   // the separable form where the system is separable
+template class Mp06Stepper<SlotSystem, false>;  // the general form
+template class DiscreteGradientStepper<SlotSystem>;
+template class ReferenceStepper<SlotSystem>;
 template RunReport run_spec<SlotSystem>(const SlotSystem&, const MethodSpec&, const Vec<double, SlotSystem::n>&,
                                         const Vec<double, SlotSystem::n>&, double, long,
                                         const SampleObserver<SlotSystem::n, SlotSystem::m>&);

@@ -3,7 +3,7 @@
 //   Q = R^5, q = (x, y1, y2, z1, z2)
 //   L = 1/2 |qd|^2 - 1/2 |q|^2 - (eps/2) (y1^2 z1^2 + y2^2 z2^2 + z1^2 z2^2)
 //   constraint  xd + y1 z1d + y2 z2d = 0,  omega = (1, 0, 0, y1, y2)
-// (eps = 1 is the system of the issue; `epsilon` scales the coupling).  L and
+// (eps = 1 by default; `epsilon` scales the coupling).  L and
 // omega are invariant under (q, v) -> (q, -v) (reversible) but the coupling
 // makes the motion chaotic: only the energy is conserved, so reversible KAM
 // theory does not apply (not declared `integrable`).

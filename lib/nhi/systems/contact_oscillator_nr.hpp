@@ -6,7 +6,7 @@
 // The added term is a total time derivative (d/dt (-cos z)), so the
 // Euler-Lagrange-d'Alembert equations, and with them every continuous
 // trajectory q(t), are exactly those of contact_oscillator (the hand-written
-// acceleration() below is the same, and tests/test_new_scenes.cpp derives it
+// acceleration() below is the same, and tests/test_scenes.cpp derives it
 // from L' by autodiff).  The momenta differ, p' = p - dS = p + (0, 0, sin z), so
 // every method defined through L or (q, p) is another map here, and the
 // reversing symmetry (q, v) -> (q, -v) does not leave L' invariant: not declared

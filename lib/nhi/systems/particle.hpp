@@ -73,10 +73,10 @@ struct Particle {
   Mat<T, 1, 3> omega(const Vec<T, 3>& q) const {
     // (-y, 0) is written as one pair, (-y) (1, 0), not entry by entry: Eigen
     // reads the row's first two entries as one 16-byte packet, and after two
-    // 8-byte stores that load missed the CPU's store-to-load forwarding and
-    // stalled (perf: a third of mp06's particle step, issue 13;
-    // experiments/speed_log.md, "Tried and dropped").  The same values for finite y (w[1] = -0 for y > 0),
-    // and every step of the particle bit for bit the same.
+    // 8-byte stores that load misses the CPU's store-to-load forwarding and
+    // stalls (a large share of mp06's particle step).  The same values as
+    // entry by entry for finite y (w[1] = -0 for y > 0), so every step of the
+    // particle is the same bit for bit.
     Mat<T, 1, 3> w;
     w.template head<2>() = Mat<T, 1, 2>::Constant(-q[1]).cwiseProduct(Mat<T, 1, 2>(cst<T>(1.0), cst<T>(0.0)));
     w[2] = cst<T>(1.0);

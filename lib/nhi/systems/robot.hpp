@@ -94,7 +94,7 @@ struct Robot {
     using std::cos;
     using std::sin;
     // cos and sin of theta before any store into w, so that GCC makes them one
-    // sincos call (issue 13; glibc's sincos gives the same bits as sin, cos).
+    // sincos call (glibc's sincos gives the same bits as sin, cos).
     const T c = cos(q[2]), s = sin(q[2]);
     Mat<T, 2, 4> w;
     w << cst<T>(1.0), cst<T>(0.0), cst<T>(0.0), -cst<T>(R) * c,  //

@@ -13,7 +13,7 @@
 //   lambda = (g cos(theta) + w u) / (1/m + a^2/I),
 //   a = (-sin(theta) lambda / m, -g + cos(theta) lambda / m, -a lambda / I).
 //
-// Exact solutions (exact_solution() below; derived in the README, "The scenes"):
+// Exact solutions (exact_solution() below):
 //  * g = 0 (the sleigh).  u' = a w^2, w' = -m a u w / (I + m a^2), and the energy
 //    E = 1/2 m u^2 + 1/2 (I + m a^2) w^2 is constant, so with c = sqrt(2E/m),
 //    k = m a c / (I + m a^2):

@@ -23,7 +23,7 @@ TEST(Scene, ResolvesDefaults) {
   EXPECT_EQ(r["composition"], "none");
 }
 
-// The methods after the paper (issue 11) and their compositions resolve.
+// The methods after the paper and the DLA resolve with every composition.
 TEST(Scene, NewMethodsAndCompositionsResolve) {
   for (const char* method : {"mp06", "discrete_gradient", "dla"})
     for (const char* c : {"none", "triple_jump", "suzuki5", "order6"}) {
@@ -42,7 +42,7 @@ struct Bad {
   std::function<void(json&)> edit;
 };
 
-// The memory refusal (issue 10, item 8) depends on the stride, not on the steps alone.
+// The memory refusal depends on the stride, not on the steps alone.
 TEST(Scene, RefusesOnlyRunsWhosePointsCannotFit) {
   json s = good();
   s["method"] = "rk4";
@@ -152,6 +152,23 @@ TEST(Scene, RobotResolvesDefaultsAndRejectsBadInput) {
           << c.what << ": " << e.what();
     }
   }
+}
+
+// At most kMaxSceneDepth arrays and objects around any value, in a scene file
+// and in a --set value; one more is refused naming the limit.
+TEST(Scene, NestingBeyondTheLimitIsRefused) {
+  const auto nested = [](int depth) { return std::string(depth, '[') + "1" + std::string(depth, ']'); };
+  EXPECT_NO_THROW(parse_scene_text(nested(kMaxSceneDepth), "test"));
+  try {
+    parse_scene_text(nested(kMaxSceneDepth + 1), "test");
+    ADD_FAILURE() << "not refused";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("nested deeper than " + std::to_string(kMaxSceneDepth)), std::string::npos)
+        << e.what();
+  }
+  json s = good();
+  EXPECT_NO_THROW(apply_override(&s, "params.kx=" + nested(kMaxSceneDepth)));
+  EXPECT_THROW(apply_override(&s, "params.kx=" + nested(kMaxSceneDepth + 1)), SceneError);
 }
 
 TEST(Scene, OverridesParseJsonOrFallBackToString) {

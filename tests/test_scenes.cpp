@@ -1,4 +1,4 @@
-// The scenes after the paper (issue 12): what each one claims about itself.
+// The scenes beyond the paper's two: what each one claims about itself.
 //  * contact_oscillator_nr has exactly the trajectories of contact_oscillator:
 //    the reference solution of one (hand-written acceleration) against a
 //    reference solution of the other whose right-hand side is derived from L'
@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "nhi/reference_body.hpp"
 #include "nhi/scene.hpp"
 #include "scenes.hpp"
 
