@@ -10,7 +10,7 @@ BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2
 
-.PHONY: all deps deps-fuzz build test test-sanitize fuzz reproduce figures sweep sweep-scaling clean
+.PHONY: all deps deps-fuzz build test test-sanitize fuzz reproduce figures readme-tables sweep sweep-scaling clean
 all: build
 
 # $(call APT,packages): apt-get install those of the packages not installed yet.
@@ -57,11 +57,9 @@ test: deps
 
 # The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its
 # own build tree (-O1 with line tables: readable reports, a shorter build).
-SANITIZE := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 test-sanitize: deps
-	cmake -S . -B $(BUILD)-sanitize $(if $(wildcard $(BUILD)-sanitize/CMakeCache.txt),,-G Ninja) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DNHI_NATIVE=OFF \
-	  -DCMAKE_CXX_FLAGS="$(SANITIZE)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE)"
+	cmake -S . -B $(BUILD)-sanitize $(if $(wildcard $(BUILD)-sanitize/CMakeCache.txt),,-G Ninja) \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DNHI_NATIVE=OFF -DNHI_SANITIZE=ON
 	cmake --build $(BUILD)-sanitize -j$(JOBS) --target nhi_tests
 	UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir $(BUILD)-sanitize --output-on-failure -j$(JOBS)
 
@@ -110,7 +108,7 @@ STUDY_TARGETS := study-convergence study-long-horizon study-stability study-work
 
 GEOMETRY_FIGURES := plots/geometry_momentum.png plots/geometry_extrinsic.png
 
-figures: $(FIGURES) $(COMPANION_FIGURES) $(STUDY_TARGETS) $(GEOMETRY_FIGURES) results/step_costs.json results/summary.md
+figures: $(FIGURES) $(COMPANION_FIGURES) $(STUDY_TARGETS) $(GEOMETRY_FIGURES) results/step_costs.json results/summary.md readme-tables
 
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
@@ -188,10 +186,15 @@ results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 	  if [ $$rc0 -ne 0 ] || [ $$rc1 -ne 0 ]; then echo "bench_steps failed" >&2; rc=1; \
 	  else $< --merge $$d/0.json $$d/1.json -o $@; rc=$$?; fi; rm -rf $$d; exit $$rc; }
 
-# Markdown tables of the study results, quoted in README.md.
+# Markdown tables of the results (results/summary.md), and the README's
+# generated tables copied from it and from `nhi list --markdown`.
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
-    results/stability.json results/step_costs.json
+    results/stability.json results/step_costs.json $(RUNS) $(COMPANION_RUNS)
 	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
+.PHONY: readme-tables
+readme-tables: results/summary.md $(NHI)
+	d=$$(mktemp -d) && { $(NHI) list --markdown > $$d/list.md && \
+	  experiments/readme_tables.sh results/summary.md $$d/list.md; rc=$$?; rm -rf $$d; exit $$rc; }
 
 # ---- The sweep of issue 14 (not part of reproduce): a fate map over h x epsilon
 # x methods x 100 initial states on the contact oscillators, sharded over MPI

@@ -68,10 +68,12 @@ std::string list_markdown(const nhi::json& c) {
   for (const auto& s : c["systems"])
     os << "| `" << s["name"].get<std::string>() << "` | " << s["n"] << " | " << s["m"] << " | " << params_of(s) << " | "
        << yes(s["reversible"]) << " | " << yes(s["separable"]) << " |\n";
-  os << "\n## methods\n\n| label | scene keys | order | symmetric | implicit | composable |\n|---|---|---|---|---|---|\n";
-  for (const auto& m : c["methods"])
+  os << "\n## methods\n\nThe methods every study runs (`nhi list` adds the variants).\n\n| label | scene keys | order | symmetric | implicit | composable |\n|---|---|---|---|---|---|\n";
+  for (const auto& m : c["methods"]) {
+    if (m["group"] != "main") continue;
     os << "| " << m["label"].get<std::string>() << " | `" << method_keys(m) << "` | " << m["order"] << " | "
        << yes(m["symmetric"]) << " | " << yes(m["implicit"]) << " | " << yes(m["composable"]) << " |\n";
+  }
   os << "\n## compositions\n\n| composition | order | stages |\n|---|---|---|\n";
   for (const auto& k : c["compositions"])
     os << "| `" << k["name"].get<std::string>() << "` | " << k["order"] << " | " << k["stages"] << " |\n";

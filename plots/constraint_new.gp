@@ -27,9 +27,9 @@ set key tmargin center horizontal maxrows 2 noopaque nobox
 do for [a = 0:m-1] {
   set title sprintf("|{/Symbol w}_%d(q) v|, whole run (log scale)", a + 1)
   set ylabel sprintf("|{/Symbol w}_%d(q) v|", a + 1)
-  plot sprintf("$dla_%d", a + 1) u 1:2 w l ls 11 t "DLA, {/Symbol a} = 1/2", \
-       sprintf("$rk4_%d", a + 1) u 1:2 w l ls 14 t "RK4", \
-       sprintf("$ref_%d", a + 1) u 1:2 w l ls 15 t "reference", \
+  plot sprintf("$dla_%d", a + 1) u 1:2 w l ls method_ls("dla a=0.5") t "DLA, {/Symbol a} = 1/2", \
+       sprintf("$rk4_%d", a + 1) u 1:2 w l ls method_ls("rk4") t "RK4", \
+       sprintf("$ref_%d", a + 1) u 1:2 w l ls method_ls("reference") t "reference", \
        sprintf("$mp_%d", a + 1) u 1:2 w p pt 7 ps 0.3 lc rgb "#ff7f0e" t "mp06", \
        sprintf("$mptj_%d", a + 1) u 1:2 w p pt 5 ps 0.3 lc rgb "#a63603" t "mp06, triple jump"
 }

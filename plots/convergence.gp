@@ -3,7 +3,7 @@
 load "plots/style.gp"
 # Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
 #   N; LABEL, FAMILY, STY[i + 1] of method i (label with its fitted order, family,
-#   10 + style; fitted_order is null where no two errors above round-off
+#   method_ls(label); fitted_order is null where no two errors above round-off
 #   remain: "p = -");
 #   $M<i>_0, $M<i>_1: h and error of method i if its family is not (0) or is (1)
 #   "isolation", rows without an error dropped.
@@ -11,7 +11,7 @@ load jq_script(sprintf("--arg scene '%s'", scene), \
   '.scenes[$scene].methods | "N = \(length)", "array LABEL[N]", "array FAMILY[N]", "array STY[N]", ' . \
   '(to_entries[] | .key as $i | .value ' . \
   ' | "LABEL[\($i + 1)] = \("\(.label) (p = \(.fitted_order | if type == "number" then (. * 100 | round / 100) else "-" end))" | gp)", ' . \
-  '   "FAMILY[\($i + 1)] = \(.family | gp)", "STY[\($i + 1)] = 10 + int(\(.style // 12 | gp))", ' . \
+  '   "FAMILY[\($i + 1)] = \(.family | gp)", "STY[\($i + 1)] = method_ls(\(.label | gp))", ' . \
   '   ((0, 1) as $want | jq_block("$M\($i)_\($want)"; ' . \
   '      select((.family == "isolation") == ($want == 1)) | [.h, .error] | transpose[] | select(.[1] != null)))), ' . \
   '"jq_ok = 1"', file)

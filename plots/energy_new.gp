@@ -22,11 +22,11 @@ set multiplot layout 2,1 title label.", energy E - E_0 (h = 0.2), methods after 
 set xlabel "t"
 set ylabel "E - E_0"
 set key bottom left
-plot $dla u 1:2 w l ls 11 t "DLA, {/Symbol a} = 1/2", \
-     $mp u 1:2 w l ls 16 t "mp06", \
-     $mptj u 1:2 w l ls 17 t "mp06, triple jump (order 4)", \
-     $rk4 u 1:2 w l ls 14 t "RK4", \
-     $ref u 1:2 w l ls 15 t "reference (CVODE Adams, tol 1e-12)"
+plot $dla u 1:2 w l ls method_ls("dla a=0.5") t "DLA, {/Symbol a} = 1/2", \
+     $mp u 1:2 w l ls method_ls("mp06") t "mp06", \
+     $mptj u 1:2 w l ls method_ls("mp06+triple_jump") t "mp06, triple jump (order 4)", \
+     $rk4 u 1:2 w l ls method_ls("rk4") t "RK4", \
+     $ref u 1:2 w l ls method_ls("reference") t "reference (CVODE Adams, tol 1e-12)"
 set xrange [0:40]
 set title "first 40 time units"
 set key bottom right horizontal maxrows 2

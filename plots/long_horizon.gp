@@ -3,7 +3,7 @@
 # Called as gnuplot -e "file='results/long_horizon.json'; scene='particle'; out='plots/long_horizon_particle.png'" plots/long_horizon.gp
 load "plots/style.gp"
 # Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
-#   N; LABEL, GROUP, STY[i + 1] of method i (label: fate, group, 10 + style);
+#   N; LABEL, GROUP, STY[i + 1] of method i (label: fate, group, method_ls(label));
 #   H (as text: the title prints it as is), T; RS, the reference solution's
 #   steps (config.reference_steps; 10^6 where the file does not record it);
 #   FI, the names of the first integrals besides E (the contact oscillators:
@@ -19,7 +19,7 @@ load jq_script(sprintf("--arg scene '%s'", scene), \
   '"H = \($s.h | gp)", "T = real(\($s.T | gp))", "RS = real(\(.config.reference_steps // 1000000 | gp))", "FI = \($fi | join(" ") | gp)", ' . \
   '($s.methods | to_entries[] | .key as $i | .value ' . \
   ' | "LABEL[\($i + 1)] = \("\(.label): \(.fate)" | gp)", "GROUP[\($i + 1)] = \(.group | gp)", ' . \
-  '   "STY[\($i + 1)] = 10 + int(\(.style // 12 | gp))", ' . \
+  '   "STY[\($i + 1)] = method_ls(\(.label | gp))", ' . \
   '   jq_block("$E\($i)"; select(.group == "main") | [.t, .max_energy_error] | transpose[] | select(.[1] > 0)), ' . \
   '   jq_block("$C\($i)"; select(.group == "main") | [.t, .max_constraint] | transpose[] | select(.[1] > 0)), ' . \
   '   jq_block("$V\($i)"; select(.group == "variant") | [.t, .max_energy_error] | transpose[] | select(.[1] > 0)), ' . \

@@ -3,7 +3,7 @@
 # Called as gnuplot -e "file='results/stability.json'; scene='particle'; out='plots/stability_particle.png'" plots/stability.gp
 load "plots/style.gp"
 # Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
-#   N; LABEL, STY[i + 1] of method i (label, 10 + style);
+#   N; LABEL, STY[i + 1] of method i (label, method_ls(label));
 #   $OK<i>, $ENERGY<i>, $SOLVE<i>, $NONFINITE<i>: h, max |E - E0| of the runs of
 #   method i that were ok, or failed on the energy threshold, in the solve, or
 #   with a non-finite state;
@@ -13,7 +13,7 @@ load jq_script(sprintf("--arg scene '%s'", scene), \
   'def runs($i; $name; status): jq_block("$\($name)\($i)"; .runs[] | select(status) | [.h, .max_abs_energy_error]); ' . \
   '.scenes[$scene].methods | "N = \(length)", "array LABEL[N]", "array STY[N]", ' . \
   '(to_entries[] | .key as $i | .value ' . \
-  ' | "LABEL[\($i + 1)] = \(.label | gp)", "STY[\($i + 1)] = 10 + int(\(.style // 12 | gp))", ' . \
+  ' | "LABEL[\($i + 1)] = \(.label | gp)", "STY[\($i + 1)] = method_ls(\(.label | gp))", ' . \
   '   runs($i; "OK"; .status == "ok"), runs($i; "ENERGY"; .failure.kind == "energy"), ' . \
   '   runs($i; "SOLVE"; .failure.kind == "solve"), runs($i; "NONFINITE"; .failure.kind == "non-finite")), ' . \
   'jq_block("$LARGEST"; .[] | [.label, (.largest_stable_h // 0.005), (.largest_surviving_h // 0.005)]), ' . \

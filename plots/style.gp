@@ -5,34 +5,55 @@ set key top left box opaque
 set style line 1 lc rgb "#1f77b4" lw 1.5   # DLA
 set style line 2 lc rgb "#d62728" lw 1.5   # RK4
 set style line 3 lc rgb "#2ca02c" lw 2.0   # benchmark (CVODE Adams)
-# One fixed colour and point type per method, everywhere: line style 10 + the
-# method's "style" in the result JSON (its position in nhi::study_methods(),
-# lib/nhi/methods.hpp: every method's main entries in the order of Methods, then
-# the variants, then the external ones).  Room for 24 methods.
-set style line 11 lc rgb "#1f77b4" pt 7  lw 1.5   # dla a=0.5
-set style line 12 lc rgb "#9467bd" pt 5  lw 1.5   # dla-sym a=0
-set style line 13 lc rgb "#17becf" pt 15 lw 1.5   # dla a=0.5+triple_jump
-set style line 14 lc rgb "#d62728" pt 9  lw 1.5   # rk4
-set style line 15 lc rgb "#2ca02c" pt 13 lw 1.5   # reference (CVODE Adams)
-set style line 16 lc rgb "#ff7f0e" pt 11 lw 1.5   # mp06
-set style line 17 lc rgb "#e6550d" pt 14 lw 1.5   # mp06+triple_jump
-set style line 18 lc rgb "#fdae6b" pt 12 lw 1.5   # mp06+suzuki5
-set style line 19 lc rgb "#a63603" pt 3  lw 1.5   # mp06+order6
-set style line 20 lc rgb "#8c564b" pt 6  lw 1.5   # discrete_gradient
-set style line 21 lc rgb "#5a3a1a" pt 8  lw 1.5   # discrete_gradient+triple_jump
-set style line 22 lc rgb "#c49c94" pt 4  lw 1.5   # dla a=0
-set style line 23 lc rgb "#e377c2" pt 6  lw 1.5   # dla a=0.25
-set style line 24 lc rgb "#bcbd22" pt 8  lw 1.5   # dla a=0.75
-set style line 25 lc rgb "#393b79" pt 10 lw 1.5   # dla a=1
-set style line 26 lc rgb "#ce6dbd" pt 12 lw 1.5   # dla-sym a=0.25
-set style line 27 lc rgb "#6baed6" pt 1  lw 1.5   # dla-sym a=0+triple_jump
-set style line 28 lc rgb "#d6a06b" pt 2  lw 1.5   # discrete_gradient+suzuki5
-set style line 29 lc rgb "#7b4173" pt 3  lw 1.5   # discrete_gradient+order6
-set style line 30 lc rgb "#7f7f7f" pt 1  lw 1.5   # rkf78 (Boost.Odeint)
-set style line 31 lc rgb "#000000" pt 2  lw 1.5   # dopri5 (Boost.Odeint)
-set style line 32 lc rgb "#aec7e8" pt 3  lw 1.5   # (next method)
-set style line 33 lc rgb "#98df8a" pt 5  lw 1.5
-set style line 34 lc rgb "#ff9896" pt 7  lw 1.5
+# One fixed colour and point type per method, everywhere, keyed by the
+# method's label (nhi::StudyMethod::label(), `nhi list`): method_ls(label) is
+# its line style.  A new method gets a line of its own here and moves no other
+# method's colour; a label not listed is drawn in grey (line style 40).
+set style line 11 lc rgb "#1f77b4" pt 7  lw 1.5
+set style line 12 lc rgb "#9467bd" pt 5  lw 1.5
+set style line 13 lc rgb "#17becf" pt 15 lw 1.5
+set style line 14 lc rgb "#d62728" pt 9  lw 1.5
+set style line 15 lc rgb "#2ca02c" pt 13 lw 1.5
+set style line 16 lc rgb "#ff7f0e" pt 11 lw 1.5
+set style line 17 lc rgb "#e6550d" pt 14 lw 1.5
+set style line 18 lc rgb "#fdae6b" pt 12 lw 1.5
+set style line 19 lc rgb "#a63603" pt 3  lw 1.5
+set style line 20 lc rgb "#8c564b" pt 6  lw 1.5
+set style line 21 lc rgb "#5a3a1a" pt 8  lw 1.5
+set style line 22 lc rgb "#c49c94" pt 4  lw 1.5
+set style line 23 lc rgb "#e377c2" pt 6  lw 1.5
+set style line 24 lc rgb "#bcbd22" pt 8  lw 1.5
+set style line 25 lc rgb "#393b79" pt 10 lw 1.5
+set style line 26 lc rgb "#ce6dbd" pt 12 lw 1.5
+set style line 27 lc rgb "#6baed6" pt 1  lw 1.5
+set style line 28 lc rgb "#d6a06b" pt 2  lw 1.5
+set style line 29 lc rgb "#7b4173" pt 3  lw 1.5
+set style line 30 lc rgb "#7f7f7f" pt 1  lw 1.5
+set style line 31 lc rgb "#000000" pt 2  lw 1.5
+set style line 40 lc rgb "#aaaaaa" pt 1  lw 1.0
+method_ls(label) = \
+  label eq "dla a=0.5" ? 11 : \
+  label eq "dla-sym a=0" ? 12 : \
+  label eq "dla a=0.5+triple_jump" ? 13 : \
+  label eq "rk4" ? 14 : \
+  label eq "reference" ? 15 : \
+  label eq "mp06" ? 16 : \
+  label eq "mp06+triple_jump" ? 17 : \
+  label eq "mp06+suzuki5" ? 18 : \
+  label eq "mp06+order6" ? 19 : \
+  label eq "discrete_gradient" ? 20 : \
+  label eq "discrete_gradient+triple_jump" ? 21 : \
+  label eq "dla a=0" ? 22 : \
+  label eq "dla a=0.25" ? 23 : \
+  label eq "dla a=0.75" ? 24 : \
+  label eq "dla a=1" ? 25 : \
+  label eq "dla-sym a=0.25" ? 26 : \
+  label eq "dla-sym a=0+triple_jump" ? 27 : \
+  label eq "discrete_gradient+suzuki5" ? 28 : \
+  label eq "discrete_gradient+order6" ? 29 : \
+  label eq "rkf78" ? 30 : \
+  label eq "dopri5" ? 31 : \
+  40
 # One jq pass per figure: calling jq once per label and per data series would
 # start jq and parse the result hundreds of times a figure.  A script
 # `load`s jq_script(opts, prog, files): the gnuplot commands that ONE run of

@@ -3,15 +3,15 @@
 # Called as gnuplot -e "file='results/work_precision.json'; scene='particle'; out='plots/work_precision_particle.png'" plots/work_precision.gp
 load "plots/style.gp"
 # Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
-#   N, the methods of this scene in their fixed order (style, one per style);
-#   LAB[i], STY[i] of the i-th (label, 10 + style), i = 1..N;
+#   N, the methods of this scene in the order of their first run;
+#   LAB[i], STY[i] of the i-th (label, method_ls(label)), i = 1..N;
 #   $FINAL<i>: CPU time and error at T = 10, $ENERGY<i>: CPU time and max
 #   |E - E0| over T = 10^4, of the runs of the i-th method with status ok.
 load jq_script(sprintf("--arg scene '%s'", scene), \
-  '.scenes[$scene].runs as $runs | [$runs[] | {label: .label, style: .style}] | unique_by(.style) ' . \
+  '.scenes[$scene].runs as $runs | reduce ($runs[] | .label) as $l ([]; if index([$l]) then . else . + [$l] end) ' . \
   '| "N = \(length)", "array LAB[N]", "array STY[N]", ' . \
-  '(to_entries[] | (.key + 1) as $i | .value.label as $lab ' . \
-  ' | "LAB[\($i)] = \($lab | gp)", "STY[\($i)] = 10 + int(\(.value.style | gp))", ' . \
+  '(to_entries[] | (.key + 1) as $i | .value as $lab ' . \
+  ' | "LAB[\($i)] = \($lab | gp)", "STY[\($i)] = method_ls(\($lab | gp))", ' . \
   '   jq_block("$FINAL\($i)"; $runs[] | select(.label == $lab and .status == "ok") | [.cpu_final, .final_error]), ' . \
   '   jq_block("$ENERGY\($i)"; $runs[] | select(.label == $lab and .status == "ok") | [.cpu_energy, .max_energy_error])), ' . \
   '"jq_ok = 1"', file)

@@ -393,3 +393,5 @@ auto DiscreteGradientStepper<S>::phase() const -> Vec<double, 2 * n> {
 }
 
 }  // namespace nhi
+
+#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again

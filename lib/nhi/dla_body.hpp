@@ -129,3 +129,5 @@ void DlaStepper<S, D>::next_guess(double h, VecN* q_guess, VecM* lambda_guess, i
 }
 
 }  // namespace nhi
+
+#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again

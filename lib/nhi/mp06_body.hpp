@@ -119,3 +119,5 @@ auto Mp06Stepper<S, kSeparableForm>::phase() const -> Vec<double, 2 * n> {
 }
 
 }  // namespace nhi
+
+#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again

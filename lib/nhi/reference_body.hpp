@@ -40,3 +40,5 @@ StepSummary ReferenceStepper<S>::step(double h) {
 }
 
 }  // namespace nhi
+
+#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again

@@ -35,6 +35,14 @@ struct Front<TypeList<T, Ts...>> {
   using type = T;
 };
 
+// The list without its first type.
+template <class List>
+struct Rest;
+template <class T, class... Ts>
+struct Rest<TypeList<T, Ts...>> {
+  using type = TypeList<Ts...>;
+};
+
 // The I-th type of a list.
 template <class List, int I>
 struct At;

@@ -10,6 +10,7 @@
 
 #include "nhi/discrete_gradient_body.hpp"
 #include "nhi/dla_body.hpp"
+#include "nhi/instances.hpp"
 #include "nhi/methods.hpp"
 #include "nhi/mp06_body.hpp"
 #include "nhi/reference_body.hpp"
@@ -65,13 +66,9 @@ std::unique_ptr<AnyStepper<S::n, S::m>> make_stepper(const S& sys, const MethodS
 
 #if NHI_SYSTEM_SLOT < NHI_SYSTEM_SLOTS
 using SlotSystem = typename At<Systems, NHI_SYSTEM_SLOT>::type;
-template class DlaStepper<SlotSystem, AlphaDiscretization>;
-template class DlaStepper<SlotSystem, SymmetricDiscretization>;
-template class DlaStepper<SlotSystem, SplitDiscretization>;
-template class Mp06Stepper<SlotSystem, true>;   // the separable form where the system is separable
-template class Mp06Stepper<SlotSystem, false>;  // the general form
-template class DiscreteGradientStepper<SlotSystem>;
-template class ReferenceStepper<SlotSystem>;
+}  // namespace nhi
+NHI_STEPPER_INSTANCES(, nhi::SlotSystem)
+namespace nhi {
 template RunReport run_spec<SlotSystem>(const SlotSystem&, const MethodSpec&, const Vec<double, SlotSystem::n>&,
                                         const Vec<double, SlotSystem::n>&, double, long,
                                         const SampleObserver<SlotSystem::n, SlotSystem::m>&);

@@ -1,6 +1,6 @@
 // The system registry: every scene the runner, the studies and the typed tests
 // know, in one list.  Adding a scene is one header in systems/ (see system.hpp
-// for what a scene provides) and one entry here; the scene parser, the list of
+// for what a scene provides) and one X(...) entry here; the scene parser, the list of
 // system names, parameter defaults and validation, default states, the typed
 // test lists and every study's list of scenes all derive from `Systems`.
 #pragma once
@@ -19,7 +19,12 @@
 
 namespace nhi {
 
-using Systems = TypeList<Particle, Robot, ContactOscillator, ContactOscillatorNR, ChaoticOscillator, Sleigh>;
+// The registration line: X(Type) for each scene, in this order.
+#define NHI_REGISTERED_SYSTEMS(X) X(Particle) X(Robot) X(ContactOscillator) X(ContactOscillatorNR) X(ChaoticOscillator) X(Sleigh)
+
+#define NHI_COMMA_THEN_(S) , S
+using Systems = typename Rest<TypeList<void NHI_REGISTERED_SYSTEMS(NHI_COMMA_THEN_)>>::type;
+#undef NHI_COMMA_THEN_
 
 inline std::vector<std::string> registered_system_names() {
   std::vector<std::string> names;
