@@ -56,7 +56,7 @@ test: deps
 	ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
 
 # The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its
-# own build tree (-O1 with line tables: readable reports, a shorter build).
+# own build tree (-O1 with line tables, for readable reports).
 test-sanitize: deps
 	cmake -S . -B $(BUILD)-sanitize $(if $(wildcard $(BUILD)-sanitize/CMakeCache.txt),,-G Ninja) \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DNHI_NATIVE=OFF -DNHI_SANITIZE=ON
@@ -191,7 +191,6 @@ results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
     results/stability.json results/step_costs.json $(RUNS) $(COMPANION_RUNS)
 	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
-.PHONY: readme-tables
 readme-tables: results/summary.md $(NHI)
 	d=$$(mktemp -d) && { $(NHI) list --markdown > $$d/list.md && \
 	  experiments/readme_tables.sh results/summary.md $$d/list.md; rc=$$?; rm -rf $$d; exit $$rc; }
