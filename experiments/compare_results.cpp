@@ -191,7 +191,8 @@ int main(int argc, char** argv) {
     if (SKIP_FILES.count(f)) { std::printf("%s: skipped (timings)\n", f.c_str()); continue; }
     if (!fs::exists(new_dir / f)) { std::printf("%s: missing in %s\n", f.c_str(), new_dir.c_str()); ++missing; fail = true; continue; }
     json a, b;
-    if (!load(old_dir / f, a) | !load(new_dir / f, b)) { unreadable = true; continue; }
+    const bool read_old = load(old_dir / f, a), read_new = load(new_dir / f, b);  // both, for both messages
+    if (!read_old || !read_new) { unreadable = true; continue; }
     Comparer c{f, ignore, {}, atol};
     std::string path;
     c.walk(a, b, path, "");

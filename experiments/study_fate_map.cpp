@@ -51,8 +51,9 @@ struct Grid {
 
 // One run: [fate letter, max |E - E0| / |E0|, steps taken].
 json run_cell(const Grid& g, size_t i) {
-  const auto [s, e, m, j, k] = g.split(i);
+  const auto [s, e, m_, j, k_] = g.split(i);
   const double h = g.hs[j];
+  const auto m = m_, k = k_;  // a lambda may not capture a structured binding (C++17)
   return nhi::visit_scene(g.scene_at[s][e], [&](const auto& sys, const auto&, const auto&) -> json {
     using S = std::decay_t<decltype(sys)>;
     if constexpr (nhi::has_section_states<S>::value) {

@@ -109,7 +109,6 @@ TEST(Theorem53, RobotDiscreteMomentumEquationHolds) {
 // unconstrained system for the symplecticity check.
 struct FreeRobot {
   static constexpr int n = 4, m = 0;
-  static constexpr const char* name = "free robot";
   Robot r;
   template <class T>
   T lagrangian(const Vec<T, 4>& q, const Vec<T, 4>& v) const { return r.lagrangian<T>(q, v); }
@@ -276,7 +275,6 @@ TEST(Symplecticity, DefectIsTheExteriorDerivativeOfTheConstraintForce) {
 // the form restricted to M_d, pulled back by one step, against itself.
 struct EpsParticle {
   static constexpr int n = 3, m = 1;
-  static constexpr const char* name = "particle, omega = dz - eps y dx";
   double eps = 1.0;
   Particle base;
   template <class T>
@@ -342,7 +340,6 @@ TEST(Symplecticity, DefectOnTheDiscreteConstraintSetShrinksAsTheConstraintBecome
 // <D2 L_d, d/du> = p_u exactly.
 struct CoupledParticle {
   static constexpr int n = 4, m = 1;
-  static constexpr const char* name = "coupled particle";
   double eps = 0.6;
   template <class T>
   T lagrangian(const Vec<T, 4>& q, const Vec<T, 4>& v) const {

@@ -34,8 +34,13 @@ struct Composition {
 
 inline const std::vector<Composition>& compositions() {
   static const std::vector<Composition> list = [] {
-    const double tj = 1.0 / (2.0 - std::cbrt(2.0));
-    const double sz = 1.0 / (4.0 - std::cbrt(4.0));
+    // 2^(1/3) and 4^(1/3) correctly rounded, as literals: glibc's cbrt(2.0)
+    // is one ulp above, and a compiler folds std::cbrt(2.0) at compile time
+    // or not, so the coefficients (and every composed run) would depend on
+    // the compiler and its options.
+    constexpr double cbrt2 = 1.2599210498948731647672106, cbrt4 = 1.5874010519681994747517056;
+    const double tj = 1.0 / (2.0 - cbrt2);
+    const double sz = 1.0 / (4.0 - cbrt4);
     const std::array<double, 5> kl = {0.39216144400731413928, 0.33259913678935943860, -0.70624617255763935981,
                                       0.082213596293550800230, 0.79854399093482996340};
     return std::vector<Composition>{

@@ -71,13 +71,15 @@ struct Concat<TypeList<As...>, TypeList<Bs...>, Rest...> {
   using type = typename Concat<TypeList<As..., Bs...>, Rest...>::type;
 };
 
-template <template <class> class Pred, class List>
+// The types of List for which Pred<T>::value.  Pred is taken as a pack so that
+// a trait with a defaulted SFINAE parameter (is_x<S, class = void>) matches.
+template <template <class...> class Pred, class List>
 struct Filter;
-template <template <class> class Pred, class... Ts>
+template <template <class...> class Pred, class... Ts>
 struct Filter<Pred, TypeList<Ts...>> {
   using type = typename Concat<std::conditional_t<Pred<Ts>::value, TypeList<Ts>, TypeList<>>...>::type;
 };
-template <template <class> class Pred, class List>
+template <template <class...> class Pred, class List>
 using filter_t = typename Filter<Pred, List>::type;
 
 }  // namespace nhi
