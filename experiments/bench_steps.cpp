@@ -13,8 +13,8 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
-#include <iostream>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -64,8 +64,8 @@ void BM_Reference(benchmark::State& state) {
   const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
   long internal = 0;
   for (auto _ : state) {
-    const nhi::RunReport rep = nhi::integrate(nhi::ReferenceStepper<S>(sys), q0, v0, 200.0, 1,
-                                              [](const auto&) { return true; });
+    const nhi::RunReport rep =
+        nhi::integrate(nhi::ReferenceStepper<S>(sys), q0, v0, 200.0, 1, [](const auto&) { return true; });
     internal += rep.internal_steps;
   }
   state.counters["internal_steps_per_run"] = double(internal) / double(state.iterations());
@@ -82,7 +82,10 @@ struct Trajectory {
     Vec<double, S::n> qc = q0, pc = nhi::momentum(st.system(), q0, v0), g = q0 + kH * v0, qn = q0, pn = pc;
     Vec<double, S::m> l = Vec<double, S::m>::Zero();
     for (int k = 0; k < kStates; ++k) {
-      q.push_back(qc); p.push_back(pc); guess.push_back(g); lambda.push_back(l);
+      q.push_back(qc);
+      p.push_back(pc);
+      guess.push_back(g);
+      lambda.push_back(l);
       st.step(qc, pc, g, &qn, &l, &pn);
       g = qn + (qn - qc);
       qc = qn;
@@ -114,18 +117,18 @@ void BM_DlaMap(benchmark::State& state, D disc) {
 // stopping rule spirit (until the update is at round-off).
 struct AnalyticParticleStep {
   double h, kx = 1.0, ky = 1.0;
-  void step(const Eigen::Vector3d& q0, const Eigen::Vector3d& p0, const Eigen::Vector3d& guess,
-            Eigen::Vector3d* q1_out, double* lambda, Eigen::Vector3d* p1) const {
+  void step(const Eigen::Vector3d& q0, const Eigen::Vector3d& p0, const Eigen::Vector3d& guess, Eigen::Vector3d* q1_out,
+            double* lambda, Eigen::Vector3d* p1) const {
     Eigen::Vector3d q1 = guess;
     double lam = *lambda;
     const double w0x = -q0[1];  // omega(q0) = (-y0, 0, 1)
     for (int it = 0; it < 20; ++it) {
       const Eigen::Vector3d v = (q1 - q0) / h, qm = 0.5 * (q0 + q1);
       Eigen::Vector4d r;
-      r[0] = p0[0] - h * kx * qm[0] - v[0] - w0x * lam;   // p + h/2 dL/dq - dL/dv - W^T lambda
+      r[0] = p0[0] - h * kx * qm[0] - v[0] - w0x * lam;  // p + h/2 dL/dq - dL/dv - W^T lambda
       r[1] = p0[1] - h * ky * qm[1] - v[1];
       r[2] = p0[2] - v[2] - lam;
-      r[3] = -qm[1] * v[0] + v[2];                          // omega(q_m) v
+      r[3] = -qm[1] * v[0] + v[2];  // omega(q_m) v
       // Same stopping rule as the library: residual at round-off relative to its terms.
       const double scale = std::abs(p0[0]) + std::abs(h * kx * qm[0]) + std::abs(v[0]) + std::abs(w0x * lam) +
                            std::abs(p0[1]) + std::abs(h * ky * qm[1]) + std::abs(v[1]) + std::abs(p0[2]) +
@@ -204,8 +207,10 @@ class Capture : public benchmark::ConsoleReporter {
         errors.push_back(r.benchmark_name() + ": " + r.error_message);
         continue;
       }
-      nhi::json row = {{"name", r.benchmark_name()}, {"iterations", r.iterations},
-                       {"real_ns", r.GetAdjustedRealTime()}, {"cpu_ns", r.GetAdjustedCPUTime()}};
+      nhi::json row = {{"name", r.benchmark_name()},
+                       {"iterations", r.iterations},
+                       {"real_ns", r.GetAdjustedRealTime()},
+                       {"cpu_ns", r.GetAdjustedCPUTime()}};
       for (const auto& [k, c] : r.counters) row["counters"][k] = double(c);
       rows.push_back(row);
     }
@@ -263,7 +268,8 @@ nhi::json step_costs(const nhi::json& rows) {
       r["ratio_to_rk4"] = r["cpu_ns"].get<double>() / rk4;
   }
   const double floor = ns("particle/analytic_newton_floor"), dla = ns("particle/dla_map_alpha0.5");
-  result["particle_dla_over_floor"] = std::isfinite(floor) && std::isfinite(dla) ? nhi::json(dla / floor) : nhi::json(nullptr);
+  result["particle_dla_over_floor"] =
+      std::isfinite(floor) && std::isfinite(dla) ? nhi::json(dla / floor) : nhi::json(nullptr);
   result["target_ratio"] = 2.0;
   const double nr_floor = ns("contact_oscillator_nr/mp06_hand_reduced_floor"), nr = ns("contact_oscillator_nr/mp06");
   result["nr_mp06_over_floor"] =

@@ -38,9 +38,8 @@ using nlohmann::json;
 // ---- What is not compared ------------------------------------------------------------
 // Object keys skipped wherever they occur (timing, provenance, machine dependent).
 const std::set<std::string> SKIP_KEYS = {
-    "meta",        "wall_seconds", "cpu_seconds", "cpu_ns",   "real_ns",
-    "cpu_final",   "cpu_energy",   "peak_rss_kb", "time_utc",
-    "cpu_energy_short", "cpu_energy_long", "busy_seconds",
+    "meta",       "wall_seconds", "cpu_seconds", "cpu_ns",           "real_ns",         "cpu_final",
+    "cpu_energy", "peak_rss_kb",  "time_utc",    "cpu_energy_short", "cpu_energy_long", "busy_seconds",
 };
 // Object keys skipped only inside one file: {file name, key}.
 const std::set<std::pair<std::string, std::string>> SKIP_KEYS_IN_FILE = {
@@ -80,9 +79,7 @@ struct Comparer {
   void structural(const std::string& path, const std::string& what) {
     if (r.structural++ < MAX_LISTED) r.structural_list.push_back((path.empty() ? "(root)" : path) + ": " + what);
   }
-  static std::string kind(const json& v) {
-    return v.is_number() ? "number" : v.type_name();
-  }
+  static std::string kind(const json& v) { return v.is_number() ? "number" : v.type_name(); }
 
   // `leaf` is the name of the nearest enclosing object key (used by --per-key).
   void walk(const json& a, const json& b, std::string& path, const std::string& leaf) {
@@ -94,7 +91,12 @@ struct Comparer {
       auto& pk = r.per_key[leaf.empty() ? "(root)" : leaf];
       pk.first = std::max(pk.first, rel);
       ++pk.second;
-      if (rel > r.max_rel) { r.max_rel = rel; r.max_path = path; r.max_old = x; r.max_new = y; }
+      if (rel > r.max_rel) {
+        r.max_rel = rel;
+        r.max_path = path;
+        r.max_old = x;
+        r.max_new = y;
+      }
     } else if (kind(a) != kind(b)) {
       structural(path, "type " + kind(a) + " -> " + kind(b));
     } else if (a.is_object()) {
@@ -103,8 +105,10 @@ struct Comparer {
         if (skipped(it.key())) continue;
         if (study_stats(it.key(), it.value(), b.contains(it.key()) ? b.at(it.key()) : json())) continue;
         path += (len ? "." : "") + it.key();
-        if (!b.contains(it.key())) structural(path, "missing in new");
-        else walk(it.value(), b.at(it.key()), path, it.key());
+        if (!b.contains(it.key()))
+          structural(path, "missing in new");
+        else
+          walk(it.value(), b.at(it.key()), path, it.key());
         path.resize(len);
       }
       for (auto it = b.begin(); it != b.end(); ++it)
@@ -120,8 +124,7 @@ struct Comparer {
         path.resize(len);
       }
     } else if (a.is_string()) {
-      if (a != b && r.text++ < MAX_LISTED)
-        r.text_list.push_back(path + ": " + a.dump() + " -> " + b.dump());
+      if (a != b && r.text++ < MAX_LISTED) r.text_list.push_back(path + ": " + a.dump() + " -> " + b.dump());
     } else if (a != b) {  // booleans (null == null)
       structural(path, "value " + a.dump() + " -> " + b.dump());
     }
@@ -130,7 +133,10 @@ struct Comparer {
 
 static bool load(const fs::path& p, json& out) {
   std::ifstream in(p);
-  if (!in) { std::printf("%s: cannot open\n", p.string().c_str()); return false; }
+  if (!in) {
+    std::printf("%s: cannot open\n", p.string().c_str());
+    return false;
+  }
   try {
     out = json::parse(in);
   } catch (const std::exception& e) {
@@ -149,7 +155,9 @@ static std::vector<std::string> json_files(const fs::path& dir) {
 }
 
 static int usage(const char* msg) {
-  std::fprintf(stderr, "%s\nusage: compare_results OLD_DIR NEW_DIR [--tol 1e-9] [--atol 0] [--ignore-key NAME]... [--per-key]\n", msg);
+  std::fprintf(
+      stderr, "%s\nusage: compare_results OLD_DIR NEW_DIR [--tol 1e-9] [--atol 0] [--ignore-key NAME]... [--per-key]\n",
+      msg);
   return 2;
 }
 
@@ -163,7 +171,10 @@ int main(int argc, char** argv) {
     if (arg == "--tol" || arg == "--atol" || arg == "--ignore-key") {
       if (i + 1 >= argc) return usage(("missing value after " + arg).c_str());
       const std::string val = argv[++i];
-      if (arg == "--ignore-key") { ignore.insert(val); continue; }
+      if (arg == "--ignore-key") {
+        ignore.insert(val);
+        continue;
+      }
       char* end = nullptr;
       const double x = std::strtod(val.c_str(), &end);
       if (val.empty() || *end != '\0' || !(x >= 0)) return usage(("bad " + arg + " value: " + val).c_str());
@@ -188,11 +199,22 @@ int main(int argc, char** argv) {
   long files_compared = 0, missing = 0;
 
   for (const auto& f : old_files) {
-    if (SKIP_FILES.count(f)) { std::printf("%s: skipped (timings)\n", f.c_str()); continue; }
-    if (!fs::exists(new_dir / f)) { std::printf("%s: missing in %s\n", f.c_str(), new_dir.c_str()); ++missing; fail = true; continue; }
+    if (SKIP_FILES.count(f)) {
+      std::printf("%s: skipped (timings)\n", f.c_str());
+      continue;
+    }
+    if (!fs::exists(new_dir / f)) {
+      std::printf("%s: missing in %s\n", f.c_str(), new_dir.c_str());
+      ++missing;
+      fail = true;
+      continue;
+    }
     json a, b;
     const bool read_old = load(old_dir / f, a), read_new = load(new_dir / f, b);  // both, for both messages
-    if (!read_old || !read_new) { unreadable = true; continue; }
+    if (!read_old || !read_new) {
+      unreadable = true;
+      continue;
+    }
     Comparer c{f, ignore, {}, atol};
     std::string path;
     c.walk(a, b, path, "");
@@ -203,25 +225,34 @@ int main(int argc, char** argv) {
     } else {
       std::printf("%s: %ld numbers, max rel diff %.3g", f.c_str(), r.numbers, r.max_rel);
       if (r.max_rel > 0) std::printf(" at %s (old %.17g, new %.17g)", r.max_path.c_str(), r.max_old, r.max_new);
-      std::printf("; %ld structural, %ld text differences%s\n", r.structural, r.text, r.max_rel > tol ? "  [> tol]" : "");
+      std::printf("; %ld structural, %ld text differences%s\n", r.structural, r.text,
+                  r.max_rel > tol ? "  [> tol]" : "");
       for (const auto& s : r.structural_list) std::printf("    structural: %s\n", s.c_str());
       for (const auto& s : r.text_list) std::printf("    text: %s\n", s.c_str());
     }
     if (per_key) {  // largest difference first, so the quantity that moved is on top
       std::vector<std::pair<std::string, std::pair<double, long>>> keys(r.per_key.begin(), r.per_key.end());
-      std::stable_sort(keys.begin(), keys.end(), [](const auto& x, const auto& y) { return x.second.first > y.second.first; });
+      std::stable_sort(keys.begin(), keys.end(),
+                       [](const auto& x, const auto& y) { return x.second.first > y.second.first; });
       for (const auto& [key, v] : keys)
         std::printf("    %-28s max rel diff %-10.3g (%ld numbers)\n", key.c_str(), v.first, v.second);
     }
     if (r.max_rel > tol || r.structural > 0) fail = true;
-    if (r.max_rel > overall) { overall = r.max_rel; overall_where = f + " " + r.max_path; }
+    if (r.max_rel > overall) {
+      overall = r.max_rel;
+      overall_where = f + " " + r.max_path;
+    }
   }
   for (const auto& f : new_files)
-    if (!std::binary_search(old_files.begin(), old_files.end(), f)) std::printf("%s: new (only in %s)\n", f.c_str(), new_dir.c_str());
+    if (!std::binary_search(old_files.begin(), old_files.end(), f))
+      std::printf("%s: new (only in %s)\n", f.c_str(), new_dir.c_str());
 
-  std::printf("\noverall max rel diff %.3g (%s); tol %.3g; %ld files compared, %ld missing\n",
-              overall, overall_where.c_str(), tol, files_compared, missing);
-  if (unreadable) { std::printf("verdict: ERROR (unreadable JSON)\n"); return 2; }
+  std::printf("\noverall max rel diff %.3g (%s); tol %.3g; %ld files compared, %ld missing\n", overall,
+              overall_where.c_str(), tol, files_compared, missing);
+  if (unreadable) {
+    std::printf("verdict: ERROR (unreadable JSON)\n");
+    return 2;
+  }
   std::printf("verdict: %s\n", fail ? "DIFFERENT (see above)" : "AGREE to tol");
   return fail ? 1 : 0;
 }

@@ -37,8 +37,8 @@ struct Mp06ContactOscillatorNR {
   long iterations = 0;  // summed over steps
 
   // *lambda: the step's multiplier on return (the start does not read it).
-  bool step(double h, const Eigen::Vector3d& q0, const Eigen::Vector3d& p0, Eigen::Vector3d* q1,
-            Eigen::Vector3d* p1, double* lambda) {
+  bool step(double h, const Eigen::Vector3d& q0, const Eigen::Vector3d& p0, Eigen::Vector3d* q1, Eigen::Vector3d* p1,
+            double* lambda) {
     const double xh = q0[0] + 0.5 * h * p0[0], yh = q0[1] + 0.5 * h * p0[1];
     const double zh = q0[2] + 0.5 * h * (p0[2] - std::sin(q0[2]));
     const double sh = std::sin(zh), ch = std::cos(zh);

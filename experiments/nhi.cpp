@@ -54,8 +54,7 @@ std::string list_text(const nhi::json& c) {
   os << "methods (label: scene keys; order):\n";
   for (const auto& m : c["methods"])
     os << "  " << m["label"].get<std::string>() << ": " << method_keys(m) << "; order " << m["order"]
-       << (m["symmetric"].get<bool>() ? ", symmetric" : "") << (m["implicit"].get<bool>() ? ", implicit" : "")
-       << "\n";
+       << (m["symmetric"].get<bool>() ? ", symmetric" : "") << (m["implicit"].get<bool>() ? ", implicit" : "") << "\n";
   os << "compositions (\"composition\", of a symmetric method):\n";
   for (const auto& k : c["compositions"])
     os << "  " << k["name"].get<std::string>() << "  order " << k["order"] << ", " << k["stages"] << " stages\n";
@@ -68,7 +67,8 @@ std::string list_markdown(const nhi::json& c) {
   for (const auto& s : c["systems"])
     os << "| `" << s["name"].get<std::string>() << "` | " << s["n"] << " | " << s["m"] << " | " << params_of(s) << " | "
        << yes(s["reversible"]) << " | " << yes(s["separable"]) << " |\n";
-  os << "\n## methods\n\nThe methods every study runs (`nhi list` adds the variants).\n\n| label | scene keys | order | symmetric | implicit | composable |\n|---|---|---|---|---|---|\n";
+  os << "\n## methods\n\nThe methods every study runs (`nhi list` adds the variants).\n\n| label | scene keys | order "
+        "| symmetric | implicit | composable |\n|---|---|---|---|---|---|\n";
   for (const auto& m : c["methods"]) {
     if (m["group"] != "main") continue;
     os << "| " << m["label"].get<std::string>() << " | `" << method_keys(m) << "` | " << m["order"] << " | "
@@ -91,8 +91,7 @@ int main(int argc, char** argv) {
   std::string scene_path, out_path;
   std::vector<std::string> sets;
   run->add_option("scene", scene_path, "Scene file (JSON)")->required();
-  run->add_option("--set", sets, "Override one scene key: key=JSON value (or a bare string)")
-      ->allow_extra_args(false);
+  run->add_option("--set", sets, "Override one scene key: key=JSON value (or a bare string)")->allow_extra_args(false);
   run->add_option("-o,--output", out_path, "Result file (default: standard output)");
   auto* list = app.add_subcommand("list", "List the systems (parameters, defaults), methods and compositions");
   bool markdown = false, as_json = false;

@@ -14,8 +14,8 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <functional>
 #include <iostream>
@@ -26,11 +26,11 @@
 #include <vector>
 
 #include "cluster.hpp"
-#include "nhi/fit.hpp"
 #include "nhi/composition.hpp"
+#include "nhi/fit.hpp"
 #include "nhi/methods.hpp"
-#include "nhi/run.hpp"
 #include "nhi/output.hpp"
+#include "nhi/run.hpp"
 #include "nhi/scene.hpp"
 #include "nhi/scene_detail.hpp"
 #include "nhi/signals.hpp"
@@ -157,8 +157,10 @@ inline void parallel_for(size_t count, int threads, const std::function<void(siz
 inline json report_json(const nhi::RunReport& rep, double h) {
   json j = {{"status", rep.ok ? "ok" : "failed"}};
   if (!rep.ok)
-    j["failure"] = {{"step", rep.failure_step}, {"time", rep.failure_step * h},
-                    {"kind", nhi::to_string(rep.failure)}, {"reason", rep.reason}};
+    j["failure"] = {{"step", rep.failure_step},
+                    {"time", rep.failure_step * h},
+                    {"kind", nhi::to_string(rep.failure)},
+                    {"reason", rep.reason}};
   return j;
 }
 
@@ -169,10 +171,14 @@ inline json report_json(const nhi::RunReport& rep, double h) {
 // times the composition's stages.  Only the balance of the ranks depends on it.
 inline double step_weight(const nhi::MethodSpec& spec) {
   double w = 1.0;
-  if (spec.kind == "dla") w = 6.0;
-  else if (spec.kind == "mp06") w = 1.5;
-  else if (spec.kind == "discrete_gradient") w = 15.0;
-  else if (spec.kind == "benchmark") w = 30.0;  // per output interval h
+  if (spec.kind == "dla")
+    w = 6.0;
+  else if (spec.kind == "mp06")
+    w = 1.5;
+  else if (spec.kind == "discrete_gradient")
+    w = 15.0;
+  else if (spec.kind == "benchmark")
+    w = 30.0;  // per output interval h
   const int stages = spec.kind == "benchmark" ? 1 : static_cast<int>(nhi::composition(spec.composition).gamma.size());
   return w * stages;
 }
@@ -266,27 +272,30 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
   const long fail_cell = fault_cell("NHI_STUDY_FAIL_CELL"), kill_cell = fault_cell("NHI_STUDY_KILL_CELL");
   // NHI_STUDY_CELL_TIMES=1: each cell's wall seconds on stderr (where a study spends its time).
   const bool cell_times = std::getenv("NHI_STUDY_CELL_TIMES") != nullptr;
-  parallel_for(mine.size(), o.threads, [&](size_t k) {
-    if (failed.load()) return;
-    const size_t i = mine[k];
-    try {
-      if (static_cast<long>(i) == kill_cell) std::raise(SIGKILL);
-      if (static_cast<long>(i) == fail_cell) throw std::runtime_error("injected failure (NHI_STUDY_FAIL_CELL)");
-      const auto c0 = std::chrono::steady_clock::now();
-      out[i] = c.run(i);
-      if (cell_times)
-        std::fprintf(stderr, "%s: cell %zu (%s): %.3f s\n", c.label.c_str(), i, c.name(i).c_str(),
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count());
-    } catch (const std::exception& e) {
-      std::lock_guard<std::mutex> lock(m);
-      errors.emplace_back(i, e.what());
-      failed = true;
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(m);
-      errors.emplace_back(i, "unknown exception");
-      failed = true;
-    }
-  }, cl.root() && !mine.empty() ? &progress : nullptr);
+  parallel_for(
+      mine.size(), o.threads,
+      [&](size_t k) {
+        if (failed.load()) return;
+        const size_t i = mine[k];
+        try {
+          if (static_cast<long>(i) == kill_cell) std::raise(SIGKILL);
+          if (static_cast<long>(i) == fail_cell) throw std::runtime_error("injected failure (NHI_STUDY_FAIL_CELL)");
+          const auto c0 = std::chrono::steady_clock::now();
+          out[i] = c.run(i);
+          if (cell_times)
+            std::fprintf(stderr, "%s: cell %zu (%s): %.3f s\n", c.label.c_str(), i, c.name(i).c_str(),
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count());
+        } catch (const std::exception& e) {
+          std::lock_guard<std::mutex> lock(m);
+          errors.emplace_back(i, e.what());
+          failed = true;
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(m);
+          errors.emplace_back(i, "unknown exception");
+          failed = true;
+        }
+      },
+      cl.root() && !mine.empty() ? &progress : nullptr);
   st.busy_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   st.cells += static_cast<long>(mine.size());
   bool interrupted = nhi::interrupt_flag().load();
@@ -317,8 +326,8 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
     if (!interrupted && errors.empty())
       for (size_t i = 0; i < c.count; ++i)
         if (received[i] != 1) {
-          errors.emplace_back(i, "received from " + std::to_string(received[i]) +
-                                     " ranks (the ranks disagree on which rank runs it)");
+          errors.emplace_back(
+              i, "received from " + std::to_string(received[i]) + " ranks (the ranks disagree on which rank runs it)");
           break;
         }
   }
@@ -330,7 +339,8 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
     std::sort(errors.begin(), errors.end());
     if (cl.root())
       for (const auto& e : errors)
-        std::fprintf(stderr, "\nstudy: %s: %s failed: %s\n", c.label.c_str(), c.name(e.first).c_str(), e.second.c_str());
+        std::fprintf(stderr, "\nstudy: %s: %s failed: %s\n", c.label.c_str(), c.name(e.first).c_str(),
+                     e.second.c_str());
     if (cl.root()) std::fprintf(stderr, "study: failed; nothing written\n");
     cl.exit_all(1);
   }
@@ -346,8 +356,11 @@ inline int finish(const Options& o, json result) {
   const RankStats& st = rank_stats();
   const json mine = {st.cells, st.estimated_cost, st.busy_seconds, nhi::interrupt_flag().load()};
   const std::vector<uint8_t> bytes = json::to_cbor(mine);
-  json stats = {{"ranks", cl.size()}, {"threads_per_rank", o.threads}, {"cells", json::array()},
-                {"estimated_cost", json::array()}, {"busy_seconds", json::array()}};
+  json stats = {{"ranks", cl.size()},
+                {"threads_per_rank", o.threads},
+                {"cells", json::array()},
+                {"estimated_cost", json::array()},
+                {"busy_seconds", json::array()}};
   bool interrupted = false;
   for (const std::string& b : cl.all_gather(std::string(bytes.begin(), bytes.end()))) {
     const json r = json::from_cbor(b);
@@ -387,8 +400,8 @@ json to_json(const nhi::Vec<double, N>& v) {
 
 // q(T) of the reference solution at rtol = atol = tol.
 template <class S>
-nhi::Vec<double, S::n> reference_q(const S& sys, const nhi::Vec<double, S::n>& q0,
-                                   const nhi::Vec<double, S::n>& v0, double T, double tol) {
+nhi::Vec<double, S::n> reference_q(const S& sys, const nhi::Vec<double, S::n>& q0, const nhi::Vec<double, S::n>& v0,
+                                   double T, double tol) {
   nhi::Vec<double, S::n> q;
   nhi::reference_solution(sys, q0, v0, T, tol, &q);
   return q;

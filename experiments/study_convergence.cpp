@@ -21,13 +21,12 @@ constexpr double kT = 10.0;
 constexpr double kFloor = 1e-10;
 constexpr size_t kFitPoints = 4;  // the finest h with error above the floor
 
-
 struct Variant {
   std::string label, family;  // family: alpha, symmetric, rk4, isolation
   double alpha = 0.5;
-  int style = 0;  // nhi::method_style (0: not a study method)
+  int style = 0;                           // nhi::method_style (0: not a study method)
   std::function<json(double h)> error_at;  // returns {"error", "cpu_seconds", "status"}
-  double weight = 1.0;  // study::step_weight: estimated cost of a step
+  double weight = 1.0;                     // study::step_weight: estimated cost of a step
 };
 
 // Error of one run that ends at q(T).
@@ -52,28 +51,38 @@ std::vector<Variant> variants(const S& sys, const Vec<double, S::n>& q0, const V
   for (const nhi::StudyMethod& m : study::methods(study::fixed_step)) {
     const nhi::MethodSpec spec = m.spec;
     const std::string family = spec.kind == "dla" ? spec.discretization : spec.kind;
-    out.push_back({m.label(), family, spec.alpha, m.style(), [=, &sys](double h) {
-                     return measure<S>(qref, [&](auto&& obs) { return nhi::run_method(sys, spec, q0, v0, h, steps(h), obs); });
-                   }, study::step_weight(spec)});
+    out.push_back({m.label(), family, spec.alpha, m.style(),
+                   [=, &sys](double h) {
+                     return measure<S>(
+                         qref, [&](auto&& obs) { return nhi::run_method(sys, spec, q0, v0, h, steps(h), obs); });
+                   },
+                   study::step_weight(spec)});
   }
   // Isolation: L_d^{aL} with omega_d^{aw}, started from p_0 = dL/dqdot or from the
   // consistent p_0 = dL/dqdot + h (aL - 1/2) dL/dq.
   for (double a : {0.0, 0.25}) {
-    struct Iso { double aL, aw; bool consistent; const char* name; };
-    for (const Iso& iso : {Iso{a, 0.5, false, "L_d^a + omega_d^1/2, p0 = dL/dv"},
-                           Iso{a, 0.5, true, "L_d^a + omega_d^1/2, consistent p0"},
-                           Iso{0.5, a, false, "L_d^1/2 + omega_d^a, p0 = dL/dv"},
-                           Iso{a, a, true, "L_d^a + omega_d^a, consistent p0"}}) {
+    struct Iso {
+      double aL, aw;
+      bool consistent;
+      const char* name;
+    };
+    for (const Iso& iso :
+         {Iso{a, 0.5, false, "L_d^a + omega_d^1/2, p0 = dL/dv"},
+          Iso{a, 0.5, true, "L_d^a + omega_d^1/2, consistent p0"},
+          Iso{0.5, a, false, "L_d^1/2 + omega_d^a, p0 = dL/dv"}, Iso{a, a, true, "L_d^a + omega_d^a, consistent p0"}}) {
       char label[96];
       std::snprintf(label, sizeof label, "%s (a=%g)", iso.name, a);
-      out.push_back({label, "isolation", a, 0, [=, &sys](double h) {
-                       Vec<double, S::n> Lq, Lv;
-                       nhi::autodiff_partials(sys, q0, v0, &Lq, &Lv);
-                       const Vec<double, S::n> p0 = iso.consistent ? Vec<double, S::n>(Lv + h * (iso.aL - 0.5) * Lq) : Lv;
-                       nhi::DlaStepper<S, nhi::SplitDiscretization> st(sys, nhi::SplitDiscretization{iso.aL, iso.aw});
-                       st.start_momentum(p0);
-                       return measure<S>(qref, [&](auto&& obs) { return nhi::integrate(st, q0, v0, h, steps(h), obs); });
-                     }, study::step_weight(nhi::MethodSpec{})});
+      out.push_back(
+          {label, "isolation", a, 0,
+           [=, &sys](double h) {
+             Vec<double, S::n> Lq, Lv;
+             nhi::autodiff_partials(sys, q0, v0, &Lq, &Lv);
+             const Vec<double, S::n> p0 = iso.consistent ? Vec<double, S::n>(Lv + h * (iso.aL - 0.5) * Lq) : Lv;
+             nhi::DlaStepper<S, nhi::SplitDiscretization> st(sys, nhi::SplitDiscretization{iso.aL, iso.aw});
+             st.start_momentum(p0);
+             return measure<S>(qref, [&](auto&& obs) { return nhi::integrate(st, q0, v0, h, steps(h), obs); });
+           },
+           study::step_weight(nhi::MethodSpec{})});
     }
   }
   return out;
@@ -94,10 +103,16 @@ int main(int argc, char** argv) {
   const study::Options opt = study::parse(argc, argv, "Convergence order over alpha, every scene");
   std::vector<double> hs;
   for (int j = 0; j <= 8; ++j) hs.push_back(0.2 / (1 << j));
-  json result = {{"study", "convergence"},
-                 {"config", {{"T", kT}, {"h", hs}, {"reference", "per scene: the exact solution where the system has one, else CVODE Adams rtol = atol = 1e-13"},
-                             {"error", "max_i |q_i(T) - q_ref,i(T)|"},
-                             {"fit", "least squares of log error on log h over the 4 finest h with error > 1e-10, after dropping finest points on a higher floor (while the last local order differs by > 0.5 from the one before it)"}}}};
+  json result = {
+      {"study", "convergence"},
+      {"config",
+       {{"T", kT},
+        {"h", hs},
+        {"reference", "per scene: the exact solution where the system has one, else CVODE Adams rtol = atol = 1e-13"},
+        {"error", "max_i |q_i(T) - q_ref,i(T)|"},
+        {"fit",
+         "least squares of log error on log h over the 4 finest h with error > 1e-10, after dropping finest points on "
+         "a higher floor (while the last local order differs by > 0.5 from the one before it)"}}}};
   for (const std::string& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     json scene_out = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
@@ -123,12 +138,18 @@ int main(int argc, char** argv) {
           rs.push_back(runs[v * hs.size() + j]);
           errs.push_back(runs[v * hs.size() + j].value("error", std::nan("")));
         }
-        json m = {{"label", vs[v].label}, {"family", vs[v].family}, {"alpha", vs[v].alpha}, {"style", vs[v].style},
-                  {"h", hs}, {"error", errs}, {"runs", rs}};
+        json m = {{"label", vs[v].label},
+                  {"family", vs[v].family},
+                  {"alpha", vs[v].alpha},
+                  {"style", vs[v].style},
+                  {"h", hs},
+                  {"error", errs},
+                  {"runs", rs}};
         m.update(fit(hs, rs));
         methods.push_back(m);
       }
-      return json{{"scene", sc}, {"reference_q", study::to_json<S::n>(qref)},
+      return json{{"scene", sc},
+                  {"reference_q", study::to_json<S::n>(qref)},
                   {"reference", exact ? "exact solution (closed form)" : "CVODE Adams rtol = atol = 1e-13"},
                   {"methods", methods}};
     });

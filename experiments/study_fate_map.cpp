@@ -199,23 +199,41 @@ int main(int argc, char** argv) {
           if (!all_broken) largest_all = g.hs[j];
           if (!half_broken) largest_half = g.hs[j];
         }
-        ms.push_back({{"label", g.methods[m].label()}, {"style", g.methods[m].style()}, {"fates", fates},
-                      {"stable", stable}, {"energy", energy}, {"solve", solve}, {"non_finite", nonfinite},
+        ms.push_back({{"label", g.methods[m].label()},
+                      {"style", g.methods[m].style()},
+                      {"fates", fates},
+                      {"stable", stable},
+                      {"energy", energy},
+                      {"solve", solve},
+                      {"non_finite", nonfinite},
                       {"median_max_rel_energy_error", med},
-                      {"largest_h_all_stable", largest_all}, {"largest_h_half_stable", largest_half}});
+                      {"largest_h_all_stable", largest_all},
+                      {"largest_h_half_stable", largest_half}});
       }
       by_value.push_back({{"value", g.values[e]}, {"methods", ms}});
     }
     scenes[g.scenes[s]] = {{"scene", g.scene_at[s][0]}, {"by_value", by_value}};
   }
   json result = {{"study", "fate_map"},
-                 {"config", {{"param", param}, {"values", g.values}, {"h", g.hs}, {"states", g.states}, {"T", g.T},
-                             {"initial_states", "sys.section_states(states): one energy level, z0 spread over +-0.9 sqrt 2"},
-                             {"fates", "s: stable (reached T, |E - E0| <= |E0| throughout); e: |E - E0| passed |E0| (stopped there); f: a step solve did not converge; n: non-finite state or energy"},
-                             {"largest_h_all_stable", "largest grid h such that at every grid h up to it every run is stable"},
-                             {"largest_h_half_stable", "the same with at least half the runs stable"}}},
-                 {"size", {{"runs", g.count()}, {"steps", total_steps}, {"scenes", g.scenes.size()},
-                           {"values", g.values.size()}, {"methods", g.methods.size()}, {"h", g.hs.size()}}},
+                 {"config",
+                  {{"param", param},
+                   {"values", g.values},
+                   {"h", g.hs},
+                   {"states", g.states},
+                   {"T", g.T},
+                   {"initial_states", "sys.section_states(states): one energy level, z0 spread over +-0.9 sqrt 2"},
+                   {"fates",
+                    "s: stable (reached T, |E - E0| <= |E0| throughout); e: |E - E0| passed |E0| (stopped there); f: a "
+                    "step solve did not converge; n: non-finite state or energy"},
+                   {"largest_h_all_stable", "largest grid h such that at every grid h up to it every run is stable"},
+                   {"largest_h_half_stable", "the same with at least half the runs stable"}}},
+                 {"size",
+                  {{"runs", g.count()},
+                   {"steps", total_steps},
+                   {"scenes", g.scenes.size()},
+                   {"values", g.values.size()},
+                   {"methods", g.methods.size()},
+                   {"h", g.hs.size()}}},
                  {"scenes", scenes}};
   return study::finish(opt, result);
 }

@@ -9,9 +9,9 @@
 //    energy and the radius along a run.
 // Initial states come from the scene files; the tests (tests/test_geometry.cpp,
 // tests/test_embedding.cpp) assert what these series show.
+#include "nhi/dla_body.hpp"
 #include "nhi/systems/circle.hpp"
 #include "nhi/systems/robot_extrinsic.hpp"
-#include "nhi/dla_body.hpp"
 #include "study.hpp"
 
 namespace {
@@ -42,7 +42,12 @@ json momentum_run(const S& sys, double alpha, double h, long steps, const Vec<do
       residual.push_back(std::abs(S::nonholonomic_momentum(qs[k + 1], ps[k + 1]) - J.back() - rhs));
     }
   }
-  json j = {{"alpha", alpha}, {"h", h}, {"t", t}, {"J", J}, {"J0_plus_sum_rhs", Jsum}, {"residual", residual},
+  json j = {{"alpha", alpha},
+            {"h", h},
+            {"t", t},
+            {"J", J},
+            {"J0_plus_sum_rhs", Jsum},
+            {"residual", residual},
             {"max_residual", *std::max_element(residual.begin(), residual.end())}};
   j["status"] = rep.ok ? "ok" : "failed";
   if (!rep.ok) j["reason"] = rep.reason;
@@ -70,15 +75,13 @@ ChartRun robot_run(bool extrinsic, double h, long steps, const Vec<double, 4>& q
     const X sys;
     nhi::DlaStepper<X, nhi::AlphaDiscretization> st(sys, mid);
     Vec<double, 4> near = q0;
-    r.ok = nhi::integrate(st, X::embed(q0), X::embed_velocity(q0, v0), h, steps,
-                              [&](const nhi::Sample<6, 2>& s) {
-                                near = X::chart(s.q, near);
-                                r.q.push_back(near);
-                                r.v.push_back(X::chart_velocity(s.q, s.v));
-                                r.max_g = std::max(r.max_g, sys.g<double>(s.q).cwiseAbs().maxCoeff());
-                                return true;
-                              })
-               .ok;
+    r.ok = nhi::integrate(st, X::embed(q0), X::embed_velocity(q0, v0), h, steps, [&](const nhi::Sample<6, 2>& s) {
+             near = X::chart(s.q, near);
+             r.q.push_back(near);
+             r.v.push_back(X::chart_velocity(s.q, s.v));
+             r.max_g = std::max(r.max_g, sys.g<double>(s.q).cwiseAbs().maxCoeff());
+             return true;
+           }).ok;
   }
   return r;
 }
@@ -95,8 +98,13 @@ json robot_series(const ChartRun& r, double h, const Vec<double, 4>& q0, const V
     maxE = std::max(maxE, std::abs(dE.back()));
     maxc = std::max(maxc, c.back());
   }
-  return {{"t", t}, {"energy_error", dE}, {"constraint", c}, {"max_abs_energy_error", maxE},
-          {"max_abs_constraint", maxc}, {"max_abs_g", r.max_g}, {"status", r.ok ? "ok" : "failed"}};
+  return {{"t", t},
+          {"energy_error", dE},
+          {"constraint", c},
+          {"max_abs_energy_error", maxE},
+          {"max_abs_constraint", maxc},
+          {"max_abs_g", r.max_g},
+          {"status", r.ok ? "ok" : "failed"}};
 }
 
 }  // namespace
@@ -106,8 +114,10 @@ int main(int argc, char** argv) {
   json out;
   try {
     const json ps = study::scene(o, "particle"), rs = study::scene(o, "robot");
-    const Vec<double, 3> pq0 = nhi::scene_detail::vector_of<3>(ps["q0"], "q0"), pv0 = nhi::scene_detail::vector_of<3>(ps["v0"], "v0");
-    const Vec<double, 4> rq0 = nhi::scene_detail::vector_of<4>(rs["q0"], "q0"), rv0 = nhi::scene_detail::vector_of<4>(rs["v0"], "v0");
+    const Vec<double, 3> pq0 = nhi::scene_detail::vector_of<3>(ps["q0"], "q0"),
+                         pv0 = nhi::scene_detail::vector_of<3>(ps["v0"], "v0");
+    const Vec<double, 4> rq0 = nhi::scene_detail::vector_of<4>(rs["q0"], "q0"),
+                         rv0 = nhi::scene_detail::vector_of<4>(rs["v0"], "v0");
     nhi::Particle particle;
     particle.kx = 0.0;  // V = ky y^2: translations in (x, z) are a symmetry
     const double h = 0.2;
@@ -134,8 +144,12 @@ int main(int argc, char** argv) {
         eex.push_back((robot_run(true, hh, n, rq0, rv0).q.back() - qT).cwiseAbs().maxCoeff());
       }
       const std::vector<double> fh(hs.end() - 4, hs.end()), fi(ein.end() - 4, ein.end()), fe(eex.end() - 4, eex.end());
-      slots[6] = {{"T", T}, {"h", hs}, {"intrinsic", ein}, {"extrinsic", eex},
-                  {"order_intrinsic", nhi::loglog_slope(fh, fi)}, {"order_extrinsic", nhi::loglog_slope(fh, fe)},
+      slots[6] = {{"T", T},
+                  {"h", hs},
+                  {"intrinsic", ein},
+                  {"extrinsic", eex},
+                  {"order_intrinsic", nhi::loglog_slope(fh, fi)},
+                  {"order_extrinsic", nhi::loglog_slope(fh, fe)},
                   {"order_fit", "least squares over the 4 smallest h"}};
     });
     // Remark 3.3: the circle, omega-DLA and g-DLA (eq. 17), h = 0.1.
@@ -166,9 +180,9 @@ int main(int argc, char** argv) {
     // Task i fills slots[i]; estimated costs in RK4 steps (the reduced flow's
     // 200000 steps dominate the convergence task).
     const std::vector<double> cost = {12000, 12000, 20000, 20000, 12000, 12000, 220000, 30000};
-    const std::vector<const char*> names = {"momentum particle a=1/2", "momentum particle a=1/4", "momentum robot a=1/2",
-                                            "momentum robot a=1/4", "robot intrinsic", "robot extrinsic",
-                                            "robot convergence", "circle (Remark 3.3)"};
+    const std::vector<const char*> names = {
+        "momentum particle a=1/2", "momentum particle a=1/4", "momentum robot a=1/2", "momentum robot a=1/4",
+        "robot intrinsic",         "robot extrinsic",         "robot convergence",    "circle (Remark 3.3)"};
     study::Cells cells;
     cells.label = "geometry";
     cells.count = tasks.size();
@@ -180,8 +194,9 @@ int main(int argc, char** argv) {
     cells.name = [&](size_t i) { return std::string(names[i]); };
     slots = study::map_cells(o, cells);
     out = {{"study", "geometry"},
-           {"momentum", {{"particle", {{"kx", 0.0}, {"ky", particle.ky}, {"runs", {slots[0], slots[1]}}}},
-                         {"robot", {{"runs", {slots[2], slots[3]}}}}}},
+           {"momentum",
+            {{"particle", {{"kx", 0.0}, {"ky", particle.ky}, {"runs", {slots[0], slots[1]}}}},
+             {"robot", {{"runs", {slots[2], slots[3]}}}}}},
            {"extrinsic", {{"h", h}, {"intrinsic", slots[4]}, {"extrinsic", slots[5]}, {"convergence", slots[6]}}},
            {"holonomic", {{"circle", slots[7]}}}};
   } catch (const std::exception& e) {

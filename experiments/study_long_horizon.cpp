@@ -74,7 +74,10 @@ class HorizonObserver {
     if (block_t_.size() > 2) {
       double st = 0, sy = 0, stt = 0, sty = 0, n = double(block_t_.size());
       for (size_t i = 0; i < block_t_.size(); ++i) {
-        st += block_t_[i]; sy += block_mean_[i]; stt += block_t_[i] * block_t_[i]; sty += block_t_[i] * block_mean_[i];
+        st += block_t_[i];
+        sy += block_mean_[i];
+        stt += block_t_[i] * block_t_[i];
+        sty += block_t_[i] * block_mean_[i];
       }
       rate = (n * sty - st * sy) / (n * stt - st * st);
     }
@@ -98,15 +101,22 @@ class HorizonObserver {
         t90 = t_[i];
         break;
       }
-    json j = {{"t", t_}, {"energy_error", dE_}, {"max_energy_error", env_dE_}, {"constraint", c_},
-              {"max_constraint", env_c_}, {"block_t", block_t_}, {"block_mean_energy_error", block_mean_},
-              {"summary", {{"max_abs_energy_error", max_dE_}, {"max_abs_constraint", max_c_},
-                           {"drift_rate", std::isfinite(rate) ? json(rate) : json(nullptr)},
-                           {"envelope_growth_exponent", std::isfinite(slope) ? json(slope) : json(nullptr)},
-                           {"late_mean_energy_error", std::isfinite(late) ? json(late) : json(nullptr)},
-                           {"t90", std::isfinite(t90) ? json(t90) : json(nullptr)},
-                           {"E0", E0_},
-                           {"last_t", last_t_}}}};
+    json j = {{"t", t_},
+              {"energy_error", dE_},
+              {"max_energy_error", env_dE_},
+              {"constraint", c_},
+              {"max_constraint", env_c_},
+              {"block_t", block_t_},
+              {"block_mean_energy_error", block_mean_},
+              {"summary",
+               {{"max_abs_energy_error", max_dE_},
+                {"max_abs_constraint", max_c_},
+                {"drift_rate", std::isfinite(rate) ? json(rate) : json(nullptr)},
+                {"envelope_growth_exponent", std::isfinite(slope) ? json(slope) : json(nullptr)},
+                {"late_mean_energy_error", std::isfinite(late) ? json(late) : json(nullptr)},
+                {"t90", std::isfinite(t90) ? json(t90) : json(nullptr)},
+                {"E0", E0_},
+                {"last_t", last_t_}}}};
     if constexpr (nhi::has_first_integrals<S>::value) {
       const auto names = S::first_integral_names();
       for (size_t i = 0; i < names.size() && i < max_dI_.size(); ++i) {
@@ -161,15 +171,23 @@ int main(int argc, char** argv) {
   study::Options opt;
   study::add_options(app, opt);
   long reference_steps = kReferenceSteps;
-  app.add_option("--reference-steps", reference_steps, "Steps of h for the reference solution (the other methods: 10^6)")
+  app.add_option("--reference-steps", reference_steps,
+                 "Steps of h for the reference solution (the other methods: 10^6)")
       ->check(CLI::Range(1000L, kSteps));
   study::parse(app, argc, argv);
   const std::vector<nhi::StudyMethod> methods = study::methods([](const nhi::StudyMethod& m) { return !m.external; });
   json result = {{"study", "long_horizon"},
-                 {"config", {{"h", "per scene: the scene file's h"}, {"steps", kSteps}, {"reference_steps", reference_steps}, {"block", kBlock},
-                             {"drift_rate", "least-squares slope of block means of E - E0 against t"},
-                             {"envelope_growth_exponent", "log-log slope of max_{s<=t} |E - E0| over t in [T/1000, T]"},
-                             {"fate", "blows up if a step solve failed or the state became non-finite; dissipates/grows if |mean of E - E0 over the last 10% of blocks| > |E0|/2 (t: when max |E - E0| reached 90% of its final value); drifts if the envelope growth exponent >= 0.1; else bounded"}}}};
+                 {"config",
+                  {{"h", "per scene: the scene file's h"},
+                   {"steps", kSteps},
+                   {"reference_steps", reference_steps},
+                   {"block", kBlock},
+                   {"drift_rate", "least-squares slope of block means of E - E0 against t"},
+                   {"envelope_growth_exponent", "log-log slope of max_{s<=t} |E - E0| over t in [T/1000, T]"},
+                   {"fate",
+                    "blows up if a step solve failed or the state became non-finite; dissipates/grows if |mean of E - "
+                    "E0 over the last 10% of blocks| > |E0|/2 (t: when max |E - E0| reached 90% of its final value); "
+                    "drifts if the envelope growth exponent >= 0.1; else bounded"}}}};
   const std::vector<std::string> scenes = study::scene_names(opt);
   std::vector<json> scene_json;
   for (const auto& name : scenes) scene_json.push_back(study::scene(opt, name));
@@ -210,7 +228,9 @@ int main(int argc, char** argv) {
   for (size_t s = 0; s < scenes.size(); ++s) {
     json ms = json::array();
     for (size_t k = 0; k < methods.size(); ++k) ms.push_back(runs[s * methods.size() + k]);
-    result["scenes"][scenes[s]] = {{"scene", scene_json[s]}, {"h", scene_json[s]["h"]}, {"T", scene_json[s]["h"].get<double>() * kSteps},
+    result["scenes"][scenes[s]] = {{"scene", scene_json[s]},
+                                   {"h", scene_json[s]["h"]},
+                                   {"T", scene_json[s]["h"].get<double>() * kSteps},
                                    {"methods", ms}};
   }
   return study::finish(opt, result);

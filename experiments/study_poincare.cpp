@@ -67,8 +67,8 @@ struct Section {
 
 // A Section as a cell's JSON (study::map_cells) and back; doubles round-trip exactly.
 json section_to_json(const Section& s) {
-  return {{"z", s.z}, {"zd", s.zd}, {"y", s.y}, {"max_y_drift", s.max_y_drift}, {"max_dI", s.max_dI},
-          {"report", s.report}, {"cpu", s.cpu}};
+  return {{"z", s.z},           {"zd", s.zd},         {"y", s.y},    {"max_y_drift", s.max_y_drift},
+          {"max_dI", s.max_dI}, {"report", s.report}, {"cpu", s.cpu}};
 }
 Section section_from_json(const json& j) {
   Section s;
@@ -103,33 +103,34 @@ Section run_section(const S& sys, const nhi::MethodSpec& spec, const Vec<double,
     return (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * d0 + (-2 * s3 + 3 * s2) * y1 + (s3 - s2) * d1;
   };
   const double c0 = study::thread_cpu_seconds();
-  const nhi::RunReport rep = nhi::run_method(sys, spec, q0, v0, kH, long(kSections) * kStride, [&](const nhi::Sample<S::n, S::m>& smp) {
-    if (smp.k == 0) return true;
-    const Vec<double, S::n> a = sys.acceleration(smp.q, smp.v);
-    if (vp[1] > 0 && smp.v[1] <= 0) {
-      double lo = 0, hi = 1;  // ydot(lo) > 0 >= ydot(hi)
-      for (int it = 0; it < 60; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (hermite(vp[1], smp.v[1], ap[1] * kH, a[1] * kH, mid) > 0 ? lo : hi) = mid;
-      }
-      const double s = 0.5 * (lo + hi);
-      Vec<double, S::n> q, v;
-      for (int i = 0; i < S::n; ++i) {
-        q[i] = hermite(qp[i], smp.q[i], vp[i] * kH, smp.v[i] * kH, s);
-        v[i] = hermite(vp[i], smp.v[i], ap[i] * kH, a[i] * kH, s);
-      }
-      sec.z.push_back(q[c]);
-      sec.zd.push_back(v[c]);
-      sec.y.push_back(q[1]);
-      sec.max_y_drift = std::max(sec.max_y_drift, std::abs(q[1] - q0[1]));
-      const auto I = sys.first_integrals(smp.q, smp.v);  // at the grid point, not interpolated
-      for (size_t i = 0; i < I.size(); ++i) sec.max_dI[i] = std::max(sec.max_dI[i], std::abs(I[i] - I0[i]));
-    }
-    qp = smp.q;
-    vp = smp.v;
-    ap = a;
-    return true;
-  });
+  const nhi::RunReport rep =
+      nhi::run_method(sys, spec, q0, v0, kH, long(kSections) * kStride, [&](const nhi::Sample<S::n, S::m>& smp) {
+        if (smp.k == 0) return true;
+        const Vec<double, S::n> a = sys.acceleration(smp.q, smp.v);
+        if (vp[1] > 0 && smp.v[1] <= 0) {
+          double lo = 0, hi = 1;  // ydot(lo) > 0 >= ydot(hi)
+          for (int it = 0; it < 60; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (hermite(vp[1], smp.v[1], ap[1] * kH, a[1] * kH, mid) > 0 ? lo : hi) = mid;
+          }
+          const double s = 0.5 * (lo + hi);
+          Vec<double, S::n> q, v;
+          for (int i = 0; i < S::n; ++i) {
+            q[i] = hermite(qp[i], smp.q[i], vp[i] * kH, smp.v[i] * kH, s);
+            v[i] = hermite(vp[i], smp.v[i], ap[i] * kH, a[i] * kH, s);
+          }
+          sec.z.push_back(q[c]);
+          sec.zd.push_back(v[c]);
+          sec.y.push_back(q[1]);
+          sec.max_y_drift = std::max(sec.max_y_drift, std::abs(q[1] - q0[1]));
+          const auto I = sys.first_integrals(smp.q, smp.v);  // at the grid point, not interpolated
+          for (size_t i = 0; i < I.size(); ++i) sec.max_dI[i] = std::max(sec.max_dI[i], std::abs(I[i] - I0[i]));
+        }
+        qp = smp.q;
+        vp = smp.v;
+        ap = a;
+        return true;
+      });
   sec.cpu = study::thread_cpu_seconds() - c0;
   sec.report = study::report_json(rep, kH);  // every run steps kH, the reference's output included
   return sec;
@@ -141,12 +142,19 @@ int main(int argc, char** argv) {
   const study::Options opt = study::parse(argc, argv, "Poincare sections of the contact oscillators");
   const std::vector<nhi::StudyMethod> methods =
       study::methods([](const nhi::StudyMethod& m) { return !m.external && m.group == "main"; });
-  json result = {{"study", "poincare"},
-                 {"config", {{"h", kH}, {"stride", kStride}, {"sections", kSections}, {"states", kStates},
-                             {"section", "(z, zd) at each maximum of the method's y (ydot from + to -), cubic Hermite interpolation between reported points; h = 2 sin(pi/40) for every method, the reference reported every h"},
-                             {"thickness", "median over 36 angular bins (around the reference section's centre) of max r - min r"},
-                             {"first_integrals", "max |I - I0| over the grid points just after each section"},
-                             {"precision", "section points rounded to 6 significant digits"}}}};
+  json result = {
+      {"study", "poincare"},
+      {"config",
+       {{"h", kH},
+        {"stride", kStride},
+        {"sections", kSections},
+        {"states", kStates},
+        {"section",
+         "(z, zd) at each maximum of the method's y (ydot from + to -), cubic Hermite interpolation between reported "
+         "points; h = 2 sin(pi/40) for every method, the reference reported every h"},
+        {"thickness", "median over 36 angular bins (around the reference section's centre) of max r - min r"},
+        {"first_integrals", "max |I - I0| over the grid points just after each section"},
+        {"precision", "section points rounded to 6 significant digits"}}}};
   for (const std::string& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     nhi::visit_scene(sc, [&](const auto& sys, const auto&, const auto&) {
@@ -160,7 +168,9 @@ int main(int argc, char** argv) {
           const auto& st = states[i % states.size()];
           return section_to_json(run_section(sys, methods[i / states.size()].spec, st.first, st.second));
         };
-        cells.cost = [&](size_t i) { return double(kSections) * kStride * study::step_weight(methods[i / states.size()].spec); };
+        cells.cost = [&](size_t i) {
+          return double(kSections) * kStride * study::step_weight(methods[i / states.size()].spec);
+        };
         cells.name = [&](size_t i) {
           return methods[i / states.size()].label() + ", initial state " + std::to_string(i % states.size());
         };
@@ -215,12 +225,14 @@ int main(int argc, char** argv) {
             std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
             summary["median_thickness_ratio"] = ratios[ratios.size() / 2];
           }
-          for (size_t i = 0; i < names.size(); ++i) summary["max_abs_" + std::string(names[i]) + "_error"] = worst_dI[i];
-          ms.push_back({{"label", methods[m].label()}, {"style", methods[m].style()}, {"summary", summary},
-                        {"runs", runs}});
+          for (size_t i = 0; i < names.size(); ++i)
+            summary["max_abs_" + std::string(names[i]) + "_error"] = worst_dI[i];
+          ms.push_back(
+              {{"label", methods[m].label()}, {"style", methods[m].style()}, {"summary", summary}, {"runs", runs}});
         }
         json init = json::array();
-        for (const auto& st : states) init.push_back({{"q0", study::to_json<S::n>(st.first)}, {"v0", study::to_json<S::n>(st.second)}});
+        for (const auto& st : states)
+          init.push_back({{"q0", study::to_json<S::n>(st.first)}, {"v0", study::to_json<S::n>(st.second)}});
         result["scenes"][name] = {{"scene", sc}, {"initial_states", init}, {"methods", ms}};
       }
       return 0;

@@ -18,8 +18,8 @@ using study::json;
 constexpr double kEnergyThreshold = 1.0;  // relative to |E0|
 
 template <class S>
-json run_one(const S& sys, const nhi::MethodSpec& spec, const Vec<double, S::n>& q0,
-             const Vec<double, S::n>& v0, const Vec<double, S::n>& qref, double h, double T) {
+json run_one(const S& sys, const nhi::MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+             const Vec<double, S::n>& qref, double h, double T) {
   const long steps = std::max(1L, std::lround(T / h));
   const double E0 = nhi::energy(sys, q0, v0);
   double max_dE = 0, exceeded_at = -1;
@@ -36,17 +36,24 @@ json run_one(const S& sys, const nhi::MethodSpec& spec, const Vec<double, S::n>&
     q_last = s.q;
     return true;
   });
-  json j = {{"h", h}, {"steps", steps}, {"max_abs_energy_error", max_dE},
-            {"fallback_steps", rep.fallbacks}, {"newton_iterations", rep.newton_iterations}};
+  json j = {{"h", h},
+            {"steps", steps},
+            {"max_abs_energy_error", max_dE},
+            {"fallback_steps", rep.fallbacks},
+            {"newton_iterations", rep.newton_iterations}};
   if (rep.ok) j["error_at_T"] = (q_last - qref).cwiseAbs().maxCoeff();
   if (!rep.ok) {
     const std::string kind = nonfinite || rep.failure == nhi::FailureKind::kNonFinite ? "non-finite" : "solve";
     j["status"] = "failed";
-    j["failure"] = {{"kind", kind}, {"step", rep.failure_step}, {"time", rep.failure_step * h},
+    j["failure"] = {{"kind", kind},
+                    {"step", rep.failure_step},
+                    {"time", rep.failure_step * h},
                     {"reason", nonfinite ? "non-finite energy" : rep.reason}};
   } else if (exceeded_at >= 0) {
     j["status"] = "failed";
-    j["failure"] = {{"kind", "energy"}, {"step", std::lround(exceeded_at / h)}, {"time", exceeded_at},
+    j["failure"] = {{"kind", "energy"},
+                    {"step", std::lround(exceeded_at / h)},
+                    {"time", exceeded_at},
                     {"reason", "|E - E0| > |E0|"}};
   } else {
     j["status"] = "ok";
@@ -68,12 +75,16 @@ int main(int argc, char** argv) {
   std::vector<double> hs;
   for (int i = 0; i <= 30; ++i) hs.push_back(0.01 * std::pow(10.0, i / 10.0));
   const std::vector<nhi::StudyMethod> methods = study::methods(study::fixed_step);
-  json result = {{"study", "stability"},
-                 {"config", {{"T", T}, {"h", hs},
-                             {"failure", "step solve not converged (solve), non-finite state (non-finite), or |E - E0| > |E0| (energy)"},
-                             {"largest_stable_h", "largest grid h such that every grid h up to it completed within the energy threshold"},
-                             {"largest_surviving_h", "largest grid h such that every grid h up to it reached T with converged solves and a finite state"},
-                             {"reference", "not swept: the reference solution (CVODE) is adaptive, its h is only the output interval"}}}};
+  json result = {
+      {"study", "stability"},
+      {"config",
+       {{"T", T},
+        {"h", hs},
+        {"failure", "step solve not converged (solve), non-finite state (non-finite), or |E - E0| > |E0| (energy)"},
+        {"largest_stable_h", "largest grid h such that every grid h up to it completed within the energy threshold"},
+        {"largest_surviving_h",
+         "largest grid h such that every grid h up to it reached T with converged solves and a finite state"},
+        {"reference", "not swept: the reference solution (CVODE) is adaptive, its h is only the output interval"}}}};
   for (const auto& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
@@ -82,9 +93,13 @@ int main(int argc, char** argv) {
       study::Cells cells;
       cells.label = "stability " + name;
       cells.count = methods.size() * hs.size();
-      cells.run = [&](size_t i) { return run_one(sys, methods[i / hs.size()].spec, q0, v0, qref, hs[i % hs.size()], T); };
+      cells.run = [&](size_t i) {
+        return run_one(sys, methods[i / hs.size()].spec, q0, v0, qref, hs[i % hs.size()], T);
+      };
       cells.cost = [&](size_t i) { return T / hs[i % hs.size()] * study::step_weight(methods[i / hs.size()].spec); };
-      cells.name = [&](size_t i) { return methods[i / hs.size()].label() + " at h = " + std::to_string(hs[i % hs.size()]); };
+      cells.name = [&](size_t i) {
+        return methods[i / hs.size()].label() + " at h = " + std::to_string(hs[i % hs.size()]);
+      };
       const std::vector<json> runs = study::map_cells(opt, cells);
       json ms = json::array();
       for (size_t m = 0; m < methods.size(); ++m) {
@@ -103,7 +118,9 @@ int main(int argc, char** argv) {
           if (r["survived"] && !dead) survivor = hs[j];
           if (!r["survived"]) dead = true;
         }
-        ms.push_back({{"label", methods[m].label()}, {"style", methods[m].style()}, {"runs", rs},
+        ms.push_back({{"label", methods[m].label()},
+                      {"style", methods[m].style()},
+                      {"runs", rs},
                       {"largest_stable_h", largest > 0 ? json(largest) : json(nullptr)},
                       {"largest_surviving_h", survivor > 0 ? json(survivor) : json(nullptr)},
                       {"first_failure", first_failure}});

@@ -68,8 +68,8 @@ using State = std::array<double, 2 * S::n>;
 
 // Adaptive Boost.Odeint run on (q, v); obs(t, q, v) at every accepted step.
 template <class S, class Stepper, class Obs>
-long odeint_run(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T,
-                double tol, Obs&& obs) {
+long odeint_run(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T, double tol,
+                Obs&& obs) {
   constexpr int n = S::n;
   State<S> x;
   for (int i = 0; i < n; ++i) {
@@ -111,8 +111,8 @@ bool long_run(const S& sys, const Config& c) {
 
 // The library methods (and the reference solution) run through run_method.
 template <class S, class Sampler>
-bool run_library(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
-                 double T, Sampler&& sample) {
+bool run_library(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T,
+                 Sampler&& sample) {
   const nhi::StudyMethod& m = c.method;
   if (m.spec.kind == "benchmark") {  // the reference solution at tolerance param, output every 0.1
     nhi::MethodSpec spec = m.spec;
@@ -137,8 +137,8 @@ struct Runaway {};
 // With `rhs`, an external pair's run counts its right-hand-side evaluations
 // there (rejected steps included).
 template <class S, class Obs>
-bool run(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
-         double T, Obs&& obs, bool guard = false, long* rhs = nullptr) {
+bool run(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T, Obs&& obs,
+         bool guard = false, long* rhs = nullptr) {
   const double E0 = nhi::energy(sys, q0, v0), bound = std::max(std::abs(E0), 1.0);
   auto checked = [&](double t, const Vec<double, S::n>& q, const Vec<double, S::n>& v) {
     if (guard && !(std::abs(nhi::energy(sys, q, v) - E0) <= bound)) throw Runaway{};
@@ -184,8 +184,10 @@ int main(int argc, char** argv) {
   const study::Options opt = study::parse(argc, argv, "Work-precision: CPU time against accuracy, every scene");
   // Fixed-step "main" methods over h; the reference solution and the external
   // adaptive pairs over tolerances.
-  const auto fixed = study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
-  const auto reference = study::methods([](const nhi::StudyMethod& m) { return m.spec.kind == "benchmark" && !m.external; });
+  const auto fixed =
+      study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
+  const auto reference =
+      study::methods([](const nhi::StudyMethod& m) { return m.spec.kind == "benchmark" && !m.external; });
   const auto external = study::methods([](const nhi::StudyMethod& m) { return m.external; });
   // Every fixed-step method over the same h (see kFinestJ).
   auto configs_for = [&](const auto&) {
@@ -199,16 +201,35 @@ int main(int argc, char** argv) {
     return configs;
   };
   json result = {{"study", "work_precision"},
-                 {"config", {{"T_final_error", kT_final}, {"T_energy", kT_energy}, {"T_energy_short", kT_energy_short},
-                             {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
-                             {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods)"},
-                             {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
-                                                tol_range(kTightestTolPairs) + " (the explicit pairs)"},
-                             {"cpu", "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms; for fixed-step methods cpu_energy is cpu_energy_short times T_energy / T_energy_short (the same steps, 100 times as many); for the reference solution (CVODE, output every 0.1) cpu_energy is the CPU time of the diagnosed run itself when that took >= 0.5 s"},
-                             {"energy_error", "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output point every 0.1 (CVODE)"}, {"energy_error_short", "the same over [0, T_energy_short]"},
-                             {"T_long", kT_long}, {"long_scenes", kLongScenes},
-                             {"energy_error_long", "max |E - E0| over [0, T_long] (a separate run), on long_scenes only, for fixed steps h >= 0.1 (h = 0.4 for energy-preserving methods) and the explicit adaptive pairs at every tolerance (dopri5 down to 1e-10); cpu_energy_long is cpu_energy scaled by the ratio of steps (fixed-step) or of right-hand-side evaluations counted in the two runs (the adaptive pairs); status_long = failed (and no max_energy_error_long) when that run failed"},
-                             {"failed", "a run is stopped and failed (status = failed, not timed) at a step failure or where |E - E0| passes max(|E0|, 1): no target is met then, and a non-conservative method's energy, and with it an adaptive method's step count, can grow without bound"}}}};
+                 {"config",
+                  {{"T_final_error", kT_final},
+                   {"T_energy", kT_energy},
+                   {"T_energy_short", kT_energy_short},
+                   {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
+                   {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods)"},
+                   {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
+                                      tol_range(kTightestTolPairs) + " (the explicit pairs)"},
+                   {"cpu",
+                    "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms; "
+                    "for fixed-step methods cpu_energy is cpu_energy_short times T_energy / T_energy_short (the same "
+                    "steps, 100 times as many); for the reference solution (CVODE, output every 0.1) cpu_energy is the "
+                    "CPU time of the diagnosed run itself when that took >= 0.5 s"},
+                   {"energy_error",
+                    "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output "
+                    "point every 0.1 (CVODE)"},
+                   {"energy_error_short", "the same over [0, T_energy_short]"},
+                   {"T_long", kT_long},
+                   {"long_scenes", kLongScenes},
+                   {"energy_error_long",
+                    "max |E - E0| over [0, T_long] (a separate run), on long_scenes only, for fixed steps h >= 0.1 (h "
+                    "= 0.4 for energy-preserving methods) and the explicit adaptive pairs at every tolerance (dopri5 "
+                    "down to 1e-10); cpu_energy_long is cpu_energy scaled by the ratio of steps (fixed-step) or of "
+                    "right-hand-side evaluations counted in the two runs (the adaptive pairs); status_long = failed "
+                    "(and no max_energy_error_long) when that run failed"},
+                   {"failed",
+                    "a run is stopped and failed (status = failed, not timed) at a step failure or where |E - E0| "
+                    "passes max(|E0|, 1): no target is met then, and a non-conservative method's energy, and with it "
+                    "an adaptive method's step count, can grow without bound"}}}};
   for (const std::string& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
@@ -235,18 +256,24 @@ int main(int argc, char** argv) {
       };
       cells.run = [&](size_t i) {
         const Config& c = configs[i];
-        json row = {{"label", c.method.label()}, {"style", c.method.style()},
-                    {"adaptive", c.method.external || c.method.spec.kind == "benchmark"}, {"param", c.param}};
+        json row = {{"label", c.method.label()},
+                    {"style", c.method.style()},
+                    {"adaptive", c.method.external || c.method.spec.kind == "benchmark"},
+                    {"param", c.param}};
         Vec<double, n> qT = q0;
-        const bool ok1 = run(sys, c, q0, v0, kT_final, [&](double, const Vec<double, n>& q, const Vec<double, n>&) { qT = q; }, true);
+        const bool ok1 = run(
+            sys, c, q0, v0, kT_final, [&](double, const Vec<double, n>& q, const Vec<double, n>&) { qT = q; }, true);
         double maxE = 0, maxE_short = 0, t_end = 0;
         long rhs_energy = 0, rhs_long = 0;  // right-hand sides of an external pair's runs
         const double cpu0 = study::thread_cpu_seconds();
-        const bool ok2 = run(sys, c, q0, v0, kT_energy, [&](double t, const Vec<double, n>& q, const Vec<double, n>& v) {
-          maxE = std::max(maxE, std::abs(nhi::energy(sys, q, v) - E0));
-          if (t <= kT_energy_short * (1 + 1e-12)) maxE_short = maxE;
-          t_end = t;
-        }, true, &rhs_energy);
+        const bool ok2 = run(
+            sys, c, q0, v0, kT_energy,
+            [&](double t, const Vec<double, n>& q, const Vec<double, n>& v) {
+              maxE = std::max(maxE, std::abs(nhi::energy(sys, q, v) - E0));
+              if (t <= kT_energy_short * (1 + 1e-12)) maxE_short = maxE;
+              t_end = t;
+            },
+            true, &rhs_energy);
         const double cpu_diagnosed = study::thread_cpu_seconds() - cpu0;
         row["status"] = ok1 && ok2 ? "ok" : "failed";
         row["final_error"] = (qT - qref).cwiseAbs().maxCoeff();
@@ -268,21 +295,25 @@ int main(int argc, char** argv) {
         // (~1e5 energies, a few ms: under 1 % of such a run), and timed
         // reruns would add a large share of the study's CPU time.
         const bool self_timed = c.method.spec.kind == "benchmark" && cpu_diagnosed >= kSelfTimed;
-        row["cpu_energy"] = self_timed                 ? cpu_diagnosed
+        row["cpu_energy"] = self_timed                    ? cpu_diagnosed
                             : row["adaptive"].get<bool>() ? cpu_per_run(sys, c, q0, v0, kT_energy)
                                                           : cpu_short * (kT_energy / kT_energy_short);
         if (long_scene && long_run(sys, c)) {
           double maxE_long = 0;
-          const bool ok3 = run(sys, c, q0, v0, kT_long, [&](double, const Vec<double, n>& q, const Vec<double, n>& v) {
-            maxE_long = std::max(maxE_long, std::abs(nhi::energy(sys, q, v) - E0));
-          }, true, &rhs_long);
+          const bool ok3 = run(
+              sys, c, q0, v0, kT_long,
+              [&](double, const Vec<double, n>& q, const Vec<double, n>& v) {
+                maxE_long = std::max(maxE_long, std::abs(nhi::energy(sys, q, v) - E0));
+              },
+              true, &rhs_long);
           if (ok3) {
             // Scaled, not timed again: a fixed-step run by its steps, an
             // external pair (the only adaptive methods run to T_long) by its
             // right-hand-side evaluations, counted in the two runs; a timed
             // rerun of the pairs to 10^6 would double the particle's cost.
-            row["cpu_energy_long"] = c.method.external ? row["cpu_energy"].get<double>() * (double(rhs_long) / double(rhs_energy))
-                                                       : cpu_short * (kT_long / kT_energy_short);
+            row["cpu_energy_long"] = c.method.external
+                                         ? row["cpu_energy"].get<double>() * (double(rhs_long) / double(rhs_energy))
+                                         : cpu_short * (kT_long / kT_energy_short);
             row["max_energy_error_long"] = maxE_long;
           } else {  // not ranked at T_long (summarize.sh needs max_energy_error_long)
             row["status_long"] = "failed";

@@ -85,9 +85,7 @@ struct Oscillator {
   Mat<T, 0, 1> omega(const Vec<T, 1>&) const {
     return Mat<T, 0, 1>();
   }
-  Vec<double, 1> acceleration(const Vec<double, 1>& q, const Vec<double, 1>&) const {
-    return -k * q;
-  }
+  Vec<double, 1> acceleration(const Vec<double, 1>& q, const Vec<double, 1>&) const { return -k * q; }
 };
 
 inline double fitted_order(const std::vector<double>& h, const std::vector<double>& err) {

@@ -120,7 +120,8 @@ std::vector<BadScene> bad_scenes() {
       {"an array nested 100000 deep", std::string(100000, '[') + std::string(100000, ']'), ""},
       {"a scene key nested 100000 deep", raw("q0", std::string(100000, '[') + "1" + std::string(100000, ']')), ""},
       // (A command-line argument is limited to 128 KiB: 1000 levels.)
-      {"--set value nested 1000 deep", particle_scene().dump(), "--set 'q0=" + std::string(1000, '[') + std::string(1000, ']') + "'"},
+      {"--set value nested 1000 deep", particle_scene().dump(),
+       "--set 'q0=" + std::string(1000, '[') + std::string(1000, ']') + "'"},
       {"empty file", "", ""},
       {"not an object", "[1, 2, 3]", ""},
       {"a bare string", "\"particle\"", ""},
@@ -134,15 +135,24 @@ std::vector<BadScene> bad_scenes() {
       {"missing q0", P([](json& s) { s.erase("q0"); }), ""},
       {"missing steps", P([](json& s) { s.erase("steps"); }), ""},
       {"unknown key", P([](json& s) { s["stepz"] = 10; }), ""},
-      {"unknown parameter", P([](json& s) { s["params"] = {{"mass", 2}}; }), ""},
-      {"params an array", P([](json& s) { s["params"] = {1, 2}; }), ""},
+      {"unknown parameter", P([](json& s) {
+         s["params"] = {{"mass", 2}};
+       }),
+       ""},
+      {"params an array", P([](json& s) {
+         s["params"] = {1, 2};
+       }),
+       ""},
       {"empty q0", P([](json& s) { s["q0"] = json::array(); }), ""},
       {"empty v0", P([](json& s) { s["v0"] = json::array(); }), ""},
       {"NaN literal", raw("h", "NaN"), ""},
       {"Infinity literal", raw("h", "Infinity"), ""},
       {"number overflowing a double", raw("h", "1e999"), ""},
       {"huge q0 entry", raw("q0", "[1e300, 0.5, 0]"), ""},
-      {"huge parameter", P([](json& s) { s["params"] = {{"kx", 1e200}}; }), ""},
+      {"huge parameter", P([](json& s) {
+         s["params"] = {{"kx", 1e200}};
+       }),
+       ""},
       {"huge steps", raw("steps", "1e30"), ""},
       {"alpha just above 1", P([](json& s) { s["alpha"] = 1.0000001; }), ""},
       {"alpha just below 0", P([](json& s) { s["alpha"] = -1e-9; }), ""},
@@ -153,14 +163,38 @@ std::vector<BadScene> bad_scenes() {
       {"steps non-integer", P([](json& s) { s["steps"] = 2.5; }), ""},
       {"output_every zero", P([](json& s) { s["output_every"] = 0; }), ""},
       {"tolerance zero", P([](json& s) { s["tolerance"] = 0; }), ""},
-      {"particle q0 of length 4", P([](json& s) { s["q0"] = {1, 0.5, 0, 0}; }), ""},
-      {"particle v0 of length 2", P([](json& s) { s["v0"] = {0.5, 1}; }), ""},
-      {"robot q0 of length 3", R([](json& s) { s["q0"] = {0, 0, 0}; }), ""},
-      {"robot v0 of length 5", R([](json& s) { s["v0"] = {1, 0, 1, 1, 0}; }), ""},
-      {"particle v0 off the constraint", P([](json& s) { s["v0"] = {0.5, 1, 0.3}; }), ""},
-      {"robot v0 off the constraint", R([](json& s) { s["v0"] = {1, 0.1, 1, 1}; }), ""},
-      {"robot with a particle parameter", R([](json& s) { s["params"] = {{"kx", 1}}; }), ""},
-      {"robot with a negative mass", R([](json& s) { s["params"] = {{"m", -1}}; }), ""},
+      {"particle q0 of length 4", P([](json& s) {
+         s["q0"] = {1, 0.5, 0, 0};
+       }),
+       ""},
+      {"particle v0 of length 2", P([](json& s) {
+         s["v0"] = {0.5, 1};
+       }),
+       ""},
+      {"robot q0 of length 3", R([](json& s) {
+         s["q0"] = {0, 0, 0};
+       }),
+       ""},
+      {"robot v0 of length 5", R([](json& s) {
+         s["v0"] = {1, 0, 1, 1, 0};
+       }),
+       ""},
+      {"particle v0 off the constraint", P([](json& s) {
+         s["v0"] = {0.5, 1, 0.3};
+       }),
+       ""},
+      {"robot v0 off the constraint", R([](json& s) {
+         s["v0"] = {1, 0.1, 1, 1};
+       }),
+       ""},
+      {"robot with a particle parameter", R([](json& s) {
+         s["params"] = {{"kx", 1}};
+       }),
+       ""},
+      {"robot with a negative mass", R([](json& s) {
+         s["params"] = {{"m", -1}};
+       }),
+       ""},
       {"unknown system", P([](json& s) { s["system"] = "pendulum"; }), ""},
       {"unknown method", P([](json& s) { s["method"] = "euler"; }), ""},
       {"unknown discretization", P([](json& s) { s["discretization"] = "trapezoid"; }), ""},
@@ -244,8 +278,13 @@ TEST_F(Cli, ListNamesEverySystemMethodAndComposition) {
   // Each listed method runs on each listed system's default state.
   for (const auto& s : c["systems"])
     for (const auto& m : c["methods"]) {
-      json scene = {{"system", s["name"]}, {"q0", s["q0"]}, {"v0", s["v0"]}, {"method", m["method"]},
-                    {"composition", m["composition"]}, {"h", 0.05}, {"steps", 3}};
+      json scene = {{"system", s["name"]},
+                    {"q0", s["q0"]},
+                    {"v0", s["v0"]},
+                    {"method", m["method"]},
+                    {"composition", m["composition"]},
+                    {"h", 0.05},
+                    {"steps", 3}};
       if (!m["discretization"].is_null()) scene["discretization"] = m["discretization"], scene["alpha"] = m["alpha"];
       EXPECT_EQ(run("run " + write("listed.json", scene.dump()) + " -o " + path("listed_out.json")).code, 0)
           << s["name"] << " " << m["label"];
@@ -377,7 +416,8 @@ TEST_F(Cli, MemoryDoesNotGrowWithTheNumberOfSteps) {
     const json j = json::parse(std::ifstream(out));
     EXPECT_EQ(j["summary"]["points"], 11);
     double recorded = 0;
-    for (const auto& e : j["energy"]) recorded = std::max(recorded, std::abs(e.get<double>() - j["energy"][0].get<double>()));
+    for (const auto& e : j["energy"])
+      recorded = std::max(recorded, std::abs(e.get<double>() - j["energy"][0].get<double>()));
     EXPECT_GE(j["summary"]["max_abs_energy_error"].get<double>(), recorded);
   }
 }
@@ -420,8 +460,8 @@ TEST_F(Cli, InterruptedRunWritesNothing) {
     ASSERT_GE(pid, 0);
     if (pid == 0) {
       const std::string sc = scene();
-      ::execl(NHI_BINARY, NHI_BINARY, "run", sc.c_str(), "--set", "steps=2000000000", "--set",
-              "output_every=100000000", "-o", out.c_str(), static_cast<char*>(nullptr));
+      ::execl(NHI_BINARY, NHI_BINARY, "run", sc.c_str(), "--set", "steps=2000000000", "--set", "output_every=100000000",
+              "-o", out.c_str(), static_cast<char*>(nullptr));
       ::_exit(127);
     }
     // Wait until the run has claimed its temporary output (the handlers are
@@ -459,8 +499,9 @@ TEST_F(Cli, InterruptedRunWritesNothing) {
 TEST_F(Cli, BenchShardsPartitionTheRowsAndMergeJoinsThem) {
   auto list = [&](const std::string& args) {
     const std::string out = path("list.txt");
-    const int status = std::system((std::string(NHI_BENCH) + " --benchmark_list_tests=true " + args + " > " + out +
-                                    " 2> " + path("list_err.txt")).c_str());
+    const int status = std::system(
+        (std::string(NHI_BENCH) + " --benchmark_list_tests=true " + args + " > " + out + " 2> " + path("list_err.txt"))
+            .c_str());
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << args;
     std::ifstream in(out);
     std::vector<std::string> rows;
@@ -481,17 +522,22 @@ TEST_F(Cli, BenchShardsPartitionTheRowsAndMergeJoinsThem) {
   EXPECT_EQ(joined, sorted);  // every row once
   for (const auto& a : s0)
     for (const auto& b : s1) EXPECT_NE(scene_of(a), scene_of(b)) << a << " and " << b;  // scenes whole
-  for (const auto& shards : {std::vector<std::string>{"--shard 2/2"}, {"--shard 1/0"}, {"--shard x"}, {"--shard 1/2/3"}})
-    EXPECT_EQ(std::system((std::string(NHI_BENCH) + " " + shards[0] + " > /dev/null 2>&1").c_str()) >> 8, 2) << shards[0];
+  for (const auto& shards :
+       {std::vector<std::string>{"--shard 2/2"}, {"--shard 1/0"}, {"--shard x"}, {"--shard 1/2/3"}})
+    EXPECT_EQ(std::system((std::string(NHI_BENCH) + " " + shards[0] + " > /dev/null 2>&1").c_str()) >> 8, 2)
+        << shards[0];
 
   auto row = [](const std::string& name, double ns) { return json{{"name", name}, {"cpu_ns", ns}}; };
-  const std::string a = write("a.json", json{{"study", "step_costs"},
-                                             {"benchmarks", {row("particle/rk4", 40), row("particle/mp06", 50)}}}.dump());
-  const std::string b = write("b.json", json{{"study", "step_costs"},
-                                             {"benchmarks", {row("robot/rk4", 100), row("robot/mp06", 90)}}}.dump());
+  const std::string a =
+      write("a.json",
+            json{{"study", "step_costs"}, {"benchmarks", {row("particle/rk4", 40), row("particle/mp06", 50)}}}.dump());
+  const std::string b = write(
+      "b.json", json{{"study", "step_costs"}, {"benchmarks", {row("robot/rk4", 100), row("robot/mp06", 90)}}}.dump());
   const std::string out = path("merged.json");
   auto merge = [&](const std::string& files) {
-    return std::system((std::string(NHI_BENCH) + " --merge " + files + " -o " + out + " 2> " + path("merge_err.txt")).c_str()) >> 8;
+    return std::system((std::string(NHI_BENCH) + " --merge " + files + " -o " + out + " 2> " + path("merge_err.txt"))
+                           .c_str()) >>
+           8;
   };
   ASSERT_EQ(merge(a + " " + b), 0);
   const json m = json::parse(std::ifstream(out));

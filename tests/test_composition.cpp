@@ -53,12 +53,13 @@ TEST(Composition, Mp06StagesStartFromTheirOwnMultipliers) {
         its_chained += t.iterations;
         ev_chained += t.evaluations;
       }
-      const Vec<double, 2 * n> a = composed.phase(), b = chained.phase();
+      const Vec<double, 2 *n> a = composed.phase(), b = chained.phase();
       worst = std::max(worst, ((a - b).cwiseAbs().array() / (1.0 + b.cwiseAbs().array())).maxCoeff());
     }
-    std::printf("    %s: per composed step Newton iterations %.2f, chained %.2f; residual evaluations %.2f, chained %.2f; "
-                "largest difference %.2g\n",
-                name, its_composed / 1000.0, its_chained / 1000.0, ev_composed / 1000.0, ev_chained / 1000.0, worst);
+    std::printf(
+        "    %s: per composed step Newton iterations %.2f, chained %.2f; residual evaluations %.2f, chained %.2f; "
+        "largest difference %.2g\n",
+        name, its_composed / 1000.0, its_chained / 1000.0, ev_composed / 1000.0, ev_chained / 1000.0, worst);
     EXPECT_LE(worst, 1e-12) << name;
   }
 }

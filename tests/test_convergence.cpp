@@ -42,8 +42,8 @@ double order_of(Run&& run_to_T) {
   }
   EXPECT_GE(hs.size(), 3u) << "too few points above the floor to fit an order";
   const double p = fitted_order(hs, errs);
-  std::printf("    fitted order %.3f over h = %g..%g (errors %.2e..%.2e)\n", p, hs.front(), hs.back(),
-              errs.front(), errs.back());
+  std::printf("    fitted order %.3f over h = %g..%g (errors %.2e..%.2e)\n", p, hs.front(), hs.back(), errs.front(),
+              errs.back());
   return p;
 }
 
@@ -52,13 +52,11 @@ double order_of(Run&& run_to_T) {
 // p_0 = dL/dqdot(q_0, v_0) is off by O(h) unless alpha = 1/2).
 template <class S, class D>
 double dla_order(const D& disc, bool consistent_start = false) {
-  return order_of<S>([&](const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
-                         double h, long steps) {
+  return order_of<S>([&](const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double h, long steps) {
     Vec<double, S::n> q, Lq, Lv;
     DlaStepper<S, D> st(sys, disc);
     autodiff_partials(sys, q0, v0, &Lq, &Lv);
-    const Vec<double, S::n> p0 =
-        consistent_start ? Vec<double, S::n>(Lv + h * (disc.nodes()[0].c - 0.5) * Lq) : Lv;
+    const Vec<double, S::n> p0 = consistent_start ? Vec<double, S::n>(Lv + h * (disc.nodes()[0].c - 0.5) * Lq) : Lv;
     st.start_momentum(p0);
     const RunReport rep = integrate(st, q0, v0, h, steps, [&](const Sample<S::n, S::m>& s) {
       q = s.q;

@@ -62,14 +62,17 @@ TYPED_TEST(DiscreteGradientTest, DiscreteGradientPassesSolveTheStep) {
       Vec<double, P::ny> y_newton;
       y_newton << qh + 0.5 * h * velocity<S, double>(sys, qh, pg), pg, before.lambda;
       ASSERT_TRUE(NewtonSolver<P>(prob).solve(&y_newton, &none).ok());
-      const Vec<double, 2 * n> z = y.template head<2 * n>(), z_newton = y_newton.template head<2 * n>();
+      const Vec<double, 2 *n> z = y.template head<2 * n>(), z_newton = y_newton.template head<2 * n>();
       worst_dz = std::max(worst_dz, ((z - z_newton).cwiseAbs().array() / (z.cwiseAbs().array() + 1.0)).maxCoeff());
       // The multiplier by the impulse h omega(qbar)^T lambda it adds to p:
       // lambda itself is set to round-off over h^2 (the rounding of Gonzalez's
       // c, ~ eps |H| / |dz|^2, enters the constraint row), its impulse over h.
       const Mat<double, S::m, n> Wb = sys.template omega<double>(Vec<double, n>(0.5 * (before.q + after.q)));
-      worst_impulse = std::max(worst_impulse, (h * Wb.transpose() * Vec<double, S::m>(after.lambda - y_newton.template tail<S::m>()))
-                                                  .cwiseAbs().maxCoeff() / (1.0 + after.p.cwiseAbs().maxCoeff()));
+      worst_impulse = std::max(worst_impulse,
+                               (h * Wb.transpose() * Vec<double, S::m>(after.lambda - y_newton.template tail<S::m>()))
+                                       .cwiseAbs()
+                                       .maxCoeff() /
+                                   (1.0 + after.p.cwiseAbs().maxCoeff()));
     }
     EXPECT_LE(worst_r, 64 * kEps) << S::name << " h " << h;
     EXPECT_LE(worst_dz, 1e-12) << S::name << " h " << h;
@@ -110,7 +113,7 @@ TYPED_TEST(DiscreteGradientTest, DiscreteGradientSettledPassesNeedNoCheck) {
     for (long k = 0; k < steps; ++k) {
       ASSERT_TRUE(checked.step(h).ok()) << S::name << " h " << h << " step " << k;
       ASSERT_TRUE(skipped.step(h).ok()) << S::name << " h " << h << " step " << k;
-      const Vec<double, 2 * n> a = checked.phase(), b = skipped.phase();
+      const Vec<double, 2 *n> a = checked.phase(), b = skipped.phase();
       if (!(a.array() == b.array()).all()) ++differ;
     }
     EXPECT_EQ(checked.settled_checks_failed(), 0) << S::name << " h " << h;
@@ -223,7 +226,7 @@ TEST(DiscreteGradientPasses, ParticleLargeStepsSolveTheStep) {
     }
     EXPECT_LE(worst_r, 64 * kEps) << "h " << h;
   }
-  EXPECT_GT(newton_steps, 0);       // both kinds of step were checked
+  EXPECT_GT(newton_steps, 0);  // both kinds of step were checked
   EXPECT_LT(newton_steps, steps);
 }
 
@@ -249,13 +252,12 @@ TEST(DiscreteGradient, ParticleStepIsTheConstrainedMidpointRule) {
     // unknowns (x1, z1, px1, pz1, lambda)
     Eigen::Matrix<double, 5, 5> K;
     Eigen::Matrix<double, 5, 1> c;
-    K << 1, 0, -h / 2, 0, 0,  //  x1 - h px1/2            = x0 + h px0/2
-        0, 1, 0, -h / 2, 0,   //  z1 - h pz1/2            = z0 + h pz0/2
+    K << 1, 0, -h / 2, 0, 0,          //  x1 - h px1/2            = x0 + h px0/2
+        0, 1, 0, -h / 2, 0,           //  z1 - h pz1/2            = z0 + h pz0/2
         sys.kx * h, 0, 1, 0, h * yb,  //  px1 + kx h x1 + h ybar lambda = px0 - kx h x0
-        0, 0, 0, 1, -h,       //  pz1 - h lambda          = pz0
-        0, 0, -yb / 2, 0.5, 0;  // -ybar (px0 + px1)/2 + (pz0 + pz1)/2 = 0
-    c << q0[0] + h / 2 * p0[0], q0[2] + h / 2 * p0[2], p0[0] - sys.kx * h * q0[0], p0[2],
-        yb / 2 * p0[0] - 0.5 * p0[2];
+        0, 0, 0, 1, -h,               //  pz1 - h lambda          = pz0
+        0, 0, -yb / 2, 0.5, 0;        // -ybar (px0 + px1)/2 + (pz0 + pz1)/2 = 0
+    c << q0[0] + h / 2 * p0[0], q0[2] + h / 2 * p0[2], p0[0] - sys.kx * h * q0[0], p0[2], yb / 2 * p0[0] - 0.5 * p0[2];
     const Eigen::Matrix<double, 5, 1> x = K.fullPivLu().solve(c);
     const Vec<double, 3> q1(x[0], y[0], x[1]), p1(x[2], y[1], x[3]);
 

@@ -41,8 +41,8 @@ std::pair<double, double> worst_residuals(const D& disc, double h, long steps) {
     const Vec<double, m> wd = discrete_constraint<S, D, double>(sys, disc, h, q, q_next, &scale);
     for (int a = 0; a < m; ++a) {
       // Judge against the size of the terms, including round-off in (q1 - q0)/h.
-      const double floor = scale[a] + sys.template omega<double>(q).row(a).cwiseAbs().dot(
-                                          (q.cwiseAbs() + q_next.cwiseAbs())) / h;
+      const double floor =
+          scale[a] + sys.template omega<double>(q).row(a).cwiseAbs().dot((q.cwiseAbs() + q_next.cwiseAbs())) / h;
       worst_c = std::max(worst_c, std::abs(wd[a]) / floor);
     }
     guess = q_next + (q_next - q);
@@ -407,7 +407,8 @@ TEST(DlaPredictor, PassesExactInThePotentialOnAQuadraticPotential) {
   EXPECT_TRUE((DlaStepper<Robot, SymmetricDiscretization>(Robot{}, {0.0}).passes_exact_in_potential()));
   EXPECT_TRUE((DlaStepper<Robot, AlphaDiscretization>(Robot{}, {1.0}).passes_exact_in_potential()));
   EXPECT_FALSE((DlaStepper<Robot, AlphaDiscretization>(Robot{}, {0.5}).passes_exact_in_potential()));
-  EXPECT_FALSE((DlaStepper<ContactOscillator, AlphaDiscretization>(ContactOscillator{}, {0.5}).passes_exact_in_potential()));
+  EXPECT_FALSE(
+      (DlaStepper<ContactOscillator, AlphaDiscretization>(ContactOscillator{}, {0.5}).passes_exact_in_potential()));
   EXPECT_TRUE((DlaStepper<Sleigh, AlphaDiscretization>(Sleigh{}, {0.5}).passes_exact_in_potential()));
   // A potential of one coordinate (the robot's V0 sin psi) with an interior
   // node: the passes take its curvature (Newton in the potential); not where
@@ -417,8 +418,10 @@ TEST(DlaPredictor, PassesExactInThePotentialOnAQuadraticPotential) {
   EXPECT_TRUE((DlaStepper<Robot, SymmetricDiscretization>(Robot{}, {0.25}).passes_newton_in_potential()));
   EXPECT_FALSE((DlaStepper<Robot, SymmetricDiscretization>(Robot{}, {0.0}).passes_newton_in_potential()));
   EXPECT_FALSE((DlaStepper<Particle, AlphaDiscretization>(Particle{}, {0.5}).passes_newton_in_potential()));
-  EXPECT_FALSE((DlaStepper<ContactOscillator, AlphaDiscretization>(ContactOscillator{}, {0.5}).passes_newton_in_potential()));
-  EXPECT_FALSE((DlaStepper<ChaoticOscillator, AlphaDiscretization>(ChaoticOscillator{}, {0.5}).passes_newton_in_potential()));
+  EXPECT_FALSE(
+      (DlaStepper<ContactOscillator, AlphaDiscretization>(ContactOscillator{}, {0.5}).passes_newton_in_potential()));
+  EXPECT_FALSE(
+      (DlaStepper<ChaoticOscillator, AlphaDiscretization>(ChaoticOscillator{}, {0.5}).passes_newton_in_potential()));
 }
 
 // The errors of the stepper's guesses after passes 0 .. P-1 against the
@@ -465,7 +468,9 @@ bool pass_errors(const D& disc, double h, Applies applies, std::array<double, P>
 template <class S, class D>
 void expect_newton_passes(const D& disc, double h) {
   std::array<double, 4> err;  // passes 0 .. 3
-  if (!pass_errors<S>(disc, h, [](const auto& st) { return st.passes_newton_in_potential(); }, &err)) return;
+  if (!pass_errors<S>(
+          disc, h, [](const auto& st) { return st.passes_newton_in_potential(); }, &err))
+    return;
   EXPECT_GT(err[1], 1e-12) << S::name << " " << disc.name() << " h " << h << ": nothing left to converge";
   EXPECT_LE(err[2], std::max(64 * kEps, 10 * err[1] * err[1])) << S::name << " " << disc.name() << " h " << h;
   EXPECT_LE(err[3], 64 * kEps) << S::name << " " << disc.name() << " h " << h;
@@ -490,7 +495,9 @@ TYPED_TEST(DlaPredictorTest, PassesWithTheCurvatureOfOneCoordinateAreNewtonSteps
 template <class S, class D>
 void expect_first_pass_exact(const D& disc, double h) {
   std::array<double, 2> err;  // the extrapolation, one pass
-  if (!pass_errors<S>(disc, h, [](const auto& st) { return st.first_pass_exact(); }, &err)) return;
+  if (!pass_errors<S>(
+          disc, h, [](const auto& st) { return st.first_pass_exact(); }, &err))
+    return;
   const std::string what = std::string(S::name) + " " + disc.name() + " h " + std::to_string(h);
   EXPECT_GT(err[0], 1e-8) << what << ": nothing left to converge";
   EXPECT_LE(err[1], 64 * kEps) << what;
@@ -505,7 +512,8 @@ TYPED_TEST(DlaPredictorTest, GaussSeidelFirstPassIsExactWhereTheConstraintForceM
 }
 
 TEST(DlaPredictor, GaussSeidelFirstPassAppliesToThePapersScenes) {  // (so the test above asserts something)
-  EXPECT_TRUE((DlaStepper<Particle, SymmetricDiscretization>(Particle{}, SymmetricDiscretization{0.0}).first_pass_exact()));
+  EXPECT_TRUE(
+      (DlaStepper<Particle, SymmetricDiscretization>(Particle{}, SymmetricDiscretization{0.0}).first_pass_exact()));
   EXPECT_TRUE((DlaStepper<Robot, SymmetricDiscretization>(make_system<Robot>(), SymmetricDiscretization{0.0})
                    .first_pass_exact()));
   EXPECT_FALSE((DlaStepper<Particle, AlphaDiscretization>(Particle{}, AlphaDiscretization{0.5}).first_pass_exact()));

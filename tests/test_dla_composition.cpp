@@ -59,9 +59,8 @@ double fitted_q_order(const S& sys, const D& disc, const std::vector<double>& ga
   std::vector<double> hs, errs;
   for (double h = 0.1; h > 0.003; h /= 2) {
     hs.push_back(h);
-    errs.push_back((q_end(sys, disc, q0, v0, p0_of(h, q0, v0), h, std::lround(T / h), gamma) - qref)
-                       .cwiseAbs()
-                       .maxCoeff());
+    errs.push_back(
+        (q_end(sys, disc, q0, v0, p0_of(h, q0, v0), h, std::lround(T / h), gamma) - qref).cwiseAbs().maxCoeff());
   }
   // The finest triple-jump error is ~2e-10 and its local order still 4.0: the
   // reference (tol 1e-13) is well below, so the floor sits under it.
@@ -109,7 +108,8 @@ TYPED_TEST(DlaComposition, StartMattersOnlyModuloTheConstraintForms) {
   Vec<double, S::n> q0, v0;
   scene_state<S>(&q0, &v0);
   const Vec<double, S::n> p0 = momentum(sys, q0, v0);
-  const Vec<double, S::n> p0_shifted = p0 + sys.template omega<double>(q0).transpose() * Vec<double, S::m>::Constant(0.7);
+  const Vec<double, S::n> p0_shifted =
+      p0 + sys.template omega<double>(q0).transpose() * Vec<double, S::m>::Constant(0.7);
   const double h = 0.05;
   const long cycles = 80;  // T = 4
   const auto check = [&](const auto& disc) {

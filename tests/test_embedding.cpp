@@ -4,8 +4,8 @@
 //    are the same integrator: v_{k+1} = J(q_{k+1}), mu-bar = mu.
 //  - The robot with its circles as unit vectors (a nonlinear embedding, outside
 //    the theorem): a different second-order integrator; how it differs.
-#include "nhi/systems/robot_extrinsic.hpp"
 #include "nhi/dla_body.hpp"
+#include "nhi/systems/robot_extrinsic.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {
@@ -117,20 +117,21 @@ TYPED_TEST(Theorem43, LinearEmbeddingGivesTheSameIntegrator) {
     for (size_t k = 1; k + 1 < qs.size(); ++k) {
       const Vec<double, n + 1> va = ext.embed(qs[k - 1]), vb = ext.embed(qs[k]);
       Vec<double, n + 1> pt, v1, p1;
-      discrete_lagrangian_slots<LinearlyEmbedded<S>, AlphaDiscretization, double>(ext, disc, h, va, vb,
-                                                                                  nullptr, &pt);
+      discrete_lagrangian_slots<LinearlyEmbedded<S>, AlphaDiscretization, double>(ext, disc, h, va, vb, nullptr, &pt);
       Vec<double, m + 1> lam = Vec<double, m + 1>::Zero();
       const StepSummary st = out.step(vb, pt, vb + (vb - va), &v1, &lam, &p1);
       ASSERT_EQ(st.status, SolveStatus::kConverged) << st.message;
       const double qscale = 1.0 + qs[k + 1].cwiseAbs().maxCoeff();
       worst_q = std::max(worst_q, (v1 - ext.embed(qs[k + 1])).cwiseAbs().maxCoeff() / qscale);
-      worst_mu = std::max(worst_mu, (lam.template head<m>() - mus[k]).cwiseAbs().maxCoeff() /
-                                        (1.0 + mus[k].cwiseAbs().maxCoeff()));
-      worst_p = std::max(worst_p, (A.transpose() * p1 - ps[k + 1]).cwiseAbs().maxCoeff() /
-                                      (1.0 + ps[k + 1].cwiseAbs().maxCoeff()));
+      worst_mu = std::max(
+          worst_mu, (lam.template head<m>() - mus[k]).cwiseAbs().maxCoeff() / (1.0 + mus[k].cwiseAbs().maxCoeff()));
+      worst_p = std::max(
+          worst_p, (A.transpose() * p1 - ps[k + 1]).cwiseAbs().maxCoeff() / (1.0 + ps[k + 1].cwiseAbs().maxCoeff()));
     }
-    std::printf("    %s, alpha = %g: one step of (17) vs (6): |v - J(q)| %.1e, |mu-bar - mu| %.1e, |A^T p-tilde - p| %.1e (relative)\n",
-                S::name, alpha, worst_q, worst_mu, worst_p);
+    std::printf(
+        "    %s, alpha = %g: one step of (17) vs (6): |v - J(q)| %.1e, |mu-bar - mu| %.1e, |A^T p-tilde - p| %.1e "
+        "(relative)\n",
+        S::name, alpha, worst_q, worst_mu, worst_p);
     // Round-off: the step is solved to a relative residual 1e-12 at most, and the
     // multiplier is the worst-conditioned output (it comes from a difference of momenta).
     EXPECT_LT(worst_q, 1e-12) << "alpha " << alpha;
@@ -161,7 +162,8 @@ TYPED_TEST(Theorem43, LinearEmbeddingRunStaysOnTheIntrinsicRun) {
                 worst = std::max(worst, (ext.chart_of(s.q, true) - qs[k]).cwiseAbs().maxCoeff() /
                                             (1.0 + qs[k].cwiseAbs().maxCoeff()));
                 // relative to |q|: the sleigh's position grows along its line
-                worst_g = std::max(worst_g, std::abs(ext.template g<double>(s.q)[0]) / (1.0 + s.q.cwiseAbs().maxCoeff()));
+                worst_g =
+                    std::max(worst_g, std::abs(ext.template g<double>(s.q)[0]) / (1.0 + s.q.cwiseAbs().maxCoeff()));
                 ++k;
                 return true;
               }).ok);
@@ -182,11 +184,13 @@ Trajectory intrinsic_run(double h, long steps) {
   Vec<double, 4> q0, v0;
   scene_state<Robot>(&q0, &v0);
   Trajectory tr;
-  EXPECT_TRUE(integrate(DlaStepper<Robot, AlphaDiscretization>(Robot{}, AlphaDiscretization{0.5}), q0, v0, h, steps, [&](const Sample<4, 2>& s) {
-                tr.q.push_back(s.q);
-                tr.v.push_back(s.v);
-                return true;
-              }).ok);
+  EXPECT_TRUE(integrate(DlaStepper<Robot, AlphaDiscretization>(Robot{}, AlphaDiscretization{0.5}), q0, v0, h, steps,
+                        [&](const Sample<4, 2>& s) {
+                          tr.q.push_back(s.q);
+                          tr.v.push_back(s.v);
+                          return true;
+                        })
+                  .ok);
   return tr;
 }
 
@@ -200,14 +204,14 @@ Trajectory extrinsic_run(double h, long steps) {
   DlaStepper<RobotExtrinsic, AlphaDiscretization> st(sys, AlphaDiscretization{0.5});
   Vec<double, 4> near = q0;
   EXPECT_TRUE(integrate(st, RobotExtrinsic::embed(q0), RobotExtrinsic::embed_velocity(q0, v0), h, steps,
-                            [&](const Sample<6, 2>& s) {
-                              const Vec<double, 4> q = RobotExtrinsic::chart(s.q, near);
-                              near = q;
-                              tr.q.push_back(q);
-                              tr.v.push_back(RobotExtrinsic::chart_velocity(s.q, s.v));
-                              tr.max_g = std::max(tr.max_g, sys.g<double>(s.q).cwiseAbs().maxCoeff());
-                              return true;
-                            })
+                        [&](const Sample<6, 2>& s) {
+                          const Vec<double, 4> q = RobotExtrinsic::chart(s.q, near);
+                          near = q;
+                          tr.q.push_back(q);
+                          tr.v.push_back(RobotExtrinsic::chart_velocity(s.q, s.v));
+                          tr.max_g = std::max(tr.max_g, sys.g<double>(s.q).cwiseAbs().maxCoeff());
+                          return true;
+                        })
                   .ok);
   return tr;
 }
@@ -239,8 +243,9 @@ TEST(ExtrinsicRobot, BothAreSecondOrder) {
     gap.push_back((a.q.back() - b.q.back()).cwiseAbs().maxCoeff());
   }
   const double s_in = loglog_slope(hs, ein), s_ex = loglog_slope(hs, eex), s_gap = loglog_slope(hs, gap);
-  std::printf("    order at T = 2: intrinsic %.2f, extrinsic %.2f, their difference %.2f; errors at h = 0.0125: %.2e, %.2e\n",
-              s_in, s_ex, s_gap, ein.back(), eex.back());
+  std::printf(
+      "    order at T = 2: intrinsic %.2f, extrinsic %.2f, their difference %.2f; errors at h = 0.0125: %.2e, %.2e\n",
+      s_in, s_ex, s_gap, ein.back(), eex.back());
   EXPECT_NEAR(s_in, 2.0, 0.15);
   EXPECT_NEAR(s_ex, 2.0, 0.15);
   EXPECT_NEAR(s_gap, 2.0, 0.15);  // they differ at O(h^2): different leading error terms

@@ -4,18 +4,17 @@
 //    Euclidean group; its continuous counterpart (eq. 23) along the benchmark.
 //  - Section 5.1: with no constraints the one-step map (q, p) -> (q', p') is
 //    symplectic; with constraints it is not.
-#include "nhi/systems/circle.hpp"
 #include "nhi/dla_body.hpp"
 #include "nhi/reference_body.hpp"
+#include "nhi/systems/circle.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {
 namespace {
 
 template <class S, class D>
-void dla_run(const S& sys, const D& disc, double h, const Vec<double, S::n>& q0,
-             const Vec<double, S::n>& v0, long steps, std::vector<Vec<double, S::n>>* qs,
-             std::vector<Vec<double, S::n>>* ps) {
+void dla_run(const S& sys, const D& disc, double h, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+             long steps, std::vector<Vec<double, S::n>>* qs, std::vector<Vec<double, S::n>>* ps) {
   const RunReport rep = integrate(DlaStepper<S, D>(sys, disc), q0, v0, h, steps, [&](const Sample<S::n, S::m>& s) {
     qs->push_back(s.q);
     ps->push_back(s.p);
@@ -96,11 +95,12 @@ TEST(Theorem53, RobotDiscreteMomentumEquationHolds) {
       const double rhs = Robot::momentum_equation_rhs(qs[k], qs[k + 1], ps[k + 1]);
       const double scale = std::abs(ps[k][2]) + std::abs(ps[k + 1][0] * d[1]) + std::abs(ps[k + 1][1] * d[0]);
       worst = std::max(worst, std::abs(Robot::nonholonomic_momentum(qs[k + 1], ps[k + 1]) -
-                                       Robot::nonholonomic_momentum(qs[k], ps[k]) - rhs) / scale);
+                                       Robot::nonholonomic_momentum(qs[k], ps[k]) - rhs) /
+                                  scale);
       largest_rhs = std::max(largest_rhs, std::abs(rhs));
     }
-    std::printf("    robot, alpha = %g: max relative residual of eq. (24) %.2e (largest right-hand side %.2e)\n",
-                alpha, worst, largest_rhs);
+    std::printf("    robot, alpha = %g: max relative residual of eq. (24) %.2e (largest right-hand side %.2e)\n", alpha,
+                worst, largest_rhs);
     EXPECT_LT(worst, 1e-12) << "alpha " << alpha;
   }
 }
@@ -111,9 +111,13 @@ struct FreeRobot {
   static constexpr int n = 4, m = 0;
   Robot r;
   template <class T>
-  T lagrangian(const Vec<T, 4>& q, const Vec<T, 4>& v) const { return r.lagrangian<T>(q, v); }
+  T lagrangian(const Vec<T, 4>& q, const Vec<T, 4>& v) const {
+    return r.lagrangian<T>(q, v);
+  }
   template <class T>
-  Mat<T, 0, 4> omega(const Vec<T, 4>&) const { return Mat<T, 0, 4>(); }
+  Mat<T, 0, 4> omega(const Vec<T, 4>&) const {
+    return Mat<T, 0, 4>();
+  }
   Vec<double, 4> acceleration(const Vec<double, 4>& q, const Vec<double, 4>&) const {
     return Vec<double, 4>(0, 0, 0, -r.V0 * std::cos(q[3]) / (3 * r.Iw));
   }
@@ -170,8 +174,7 @@ Eigen::MatrixXd step_map_jacobian(const S& sys, const D& disc, double h, const V
     Eigen::MatrixXd G = Eigen::MatrixXd::Zero(2 * n, 2 * n);  // G(i, c) = d b_i / d x_c
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < 2 * n; ++c)
-        for (int a = 0; a < m; ++a)
-          G(i, c) += (c < n ? W(a, i).v[c] * lambda[a] : 0.0) + W(a, i).a * dy(n + a, c);
+        for (int a = 0; a < m; ++a) G(i, c) += (c < n ? W(a, i).v[c] * lambda[a] : 0.0) + W(a, i).a * dy(n + a, c);
     *dbeta = G.transpose() - G;
   }
   return Dphi;
@@ -238,8 +241,8 @@ TEST(Symplecticity, UnconstrainedDlaMapIsSymplectic) {
 TEST(Symplecticity, ConstrainedDlaMapIsNot) {
   // Eq. (22): with constraints the discrete form evolves by d(beta_d) != 0.
   const Robot sys;
-  const double d = symplectic_defect(sys, AlphaDiscretization{0.5}, 0.2, Vec<double, 4>(0, 0, 0, 0),
-                                     Vec<double, 4>(1, 0, 1, 1));
+  const double d =
+      symplectic_defect(sys, AlphaDiscretization{0.5}, 0.2, Vec<double, 4>(0, 0, 0, 0), Vec<double, 4>(1, 0, 1, 1));
   std::printf("    robot with constraints: symplectic defect %.2e\n", d);
   EXPECT_GT(d, 1e-3);
 }
@@ -249,8 +252,8 @@ TEST(Symplecticity, ConstrainedDlaMapIsNot) {
 template <class S, class D>
 void check_eq22(const S& sys, const D& disc, double h, Vec<double, S::n> q, Vec<double, S::n> v) {
   const FormWalk w = walk_form(sys, disc, h, q, v, 100);
-  std::printf("    %s, %s: max |Dphi^T J Dphi - J - d(beta_d)| (relative) = %.2e; the defect itself >= %.2e\n",
-              S::name, disc.name().c_str(), w.eq22, w.smallest_defect);
+  std::printf("    %s, %s: max |Dphi^T J Dphi - J - d(beta_d)| (relative) = %.2e; the defect itself >= %.2e\n", S::name,
+              disc.name().c_str(), w.eq22, w.smallest_defect);
   EXPECT_LT(w.eq22, 1e-13);
   EXPECT_GT(w.smallest_defect, 1e-3);  // and the defect is really there
 }
@@ -278,7 +281,9 @@ struct EpsParticle {
   double eps = 1.0;
   Particle base;
   template <class T>
-  T lagrangian(const Vec<T, 3>& q, const Vec<T, 3>& v) const { return base.lagrangian<T>(q, v); }
+  T lagrangian(const Vec<T, 3>& q, const Vec<T, 3>& v) const {
+    return base.lagrangian<T>(q, v);
+  }
   template <class T>
   Mat<T, 1, 3> omega(const Vec<T, 3>& q) const {
     Mat<T, 1, 3> w;
@@ -375,8 +380,10 @@ TEST(Corollary54, HorizontalSymmetryMomentumIsConservedExactly) {
       drift = std::max(drift, std::abs(ps[k][3] - ps[0][3]));
       yd_range = std::max(yd_range, std::abs(ps[k][1] - ps[0][1]));
     }
-    std::printf("    coupled particle, alpha = %g: max per-step |dp_u| = %.1f x eps |q|/h; total drift %.2e over 5000 steps (p_y varies by %.2f)\n",
-                alpha, worst_step, drift, yd_range);
+    std::printf(
+        "    coupled particle, alpha = %g: max per-step |dp_u| = %.1f x eps |q|/h; total drift %.2e over 5000 steps "
+        "(p_y varies by %.2f)\n",
+        alpha, worst_step, drift, yd_range);
     EXPECT_LT(worst_step, 64.0);
     EXPECT_GT(yd_range, 0.1);  // the coupling is exercised
   }
@@ -423,8 +430,8 @@ TEST(Remark33, MidpointDlaIsShakeOnTheCircle) {
     }
     const Eigen::Vector2d q1 = x.head<2>();
     const Eigen::Vector2d p1 = (q1 - q) / h - Eigen::Vector2d(0.0, 0.5 * h * sys.gravity);
-    worst = std::max(worst, std::max((q1 - qs[k + 1]).cwiseAbs().maxCoeff(),
-                                     h * (p1 - ps[k + 1]).cwiseAbs().maxCoeff()));
+    worst =
+        std::max(worst, std::max((q1 - qs[k + 1]).cwiseAbs().maxCoeff(), h * (p1 - ps[k + 1]).cwiseAbs().maxCoeff()));
     if (k >= 1) {
       const Vec<double, 2> v = (qs[k + 1] - qs[k - 1]) / (2 * h);
       worst_energy = std::max(worst_energy, std::abs(energy(sys, qs[k], v) - E0));
@@ -432,11 +439,13 @@ TEST(Remark33, MidpointDlaIsShakeOnTheCircle) {
   }
   double radius_drift = 0;
   for (const auto& qk : qs) radius_drift = std::max(radius_drift, std::abs(qk.norm() - 1.0));
-  std::printf("    circle: max one-step |q_DLA - q_SHAKE|, h |p_DLA - p_SHAKE| = %.2e; max ||q| - 1| = %.2e over 5000 steps; max |E - E0| = %.2e\n",
-              worst, radius_drift, worst_energy);
+  std::printf(
+      "    circle: max one-step |q_DLA - q_SHAKE|, h |p_DLA - p_SHAKE| = %.2e; max ||q| - 1| = %.2e over 5000 steps; "
+      "max |E - E0| = %.2e\n",
+      worst, radius_drift, worst_energy);
   EXPECT_LT(worst, 64 * std::numeric_limits<double>::epsilon());
   EXPECT_LT(radius_drift, 1e-11);  // round-off random walk of a conserved |q|
-  EXPECT_LT(worst_energy, 0.05);  // bounded, O(h^2)
+  EXPECT_LT(worst_energy, 0.05);   // bounded, O(h^2)
 }
 
 // The same circle in the Constrained Coordinate Formulation (eq. 17): its force
@@ -457,15 +466,18 @@ TEST(Remark33, HolonomicFormulationGivesTheSameStep) {
     Vec<double, 1> lam = Vec<double, 1>::Zero();
     ASSERT_EQ(st.step(qa[k], pa[k], qa[k] + h * pa[k], &q1, &lam, &p1).status, SolveStatus::kConverged);
     radius = std::max(radius, std::abs(qa[k].norm() - 1.0));
-    worst = std::max(worst, std::max((q1 - qa[k + 1]).cwiseAbs().maxCoeff(), h * (p1 - pa[k + 1]).cwiseAbs().maxCoeff()));
+    worst =
+        std::max(worst, std::max((q1 - qa[k + 1]).cwiseAbs().maxCoeff(), h * (p1 - pa[k + 1]).cwiseAbs().maxCoeff()));
   }
   // The whole run in the g formulation, for the record (round-off differences
   // become a phase difference that grows along the run).
   dla_run(CircleHolonomic{}, AlphaDiscretization{0.5}, h, q0, v0, 5000, &qb, &pb);
   double run = 0;
   for (size_t k = 0; k < qa.size(); ++k) run = std::max(run, (qa[k] - qb[k]).cwiseAbs().maxCoeff());
-  std::printf("    circle: one eq.-17 step vs the omega-DLA step: max difference %.2e (radius drift %.2e); whole runs differ by %.2e after 5000 steps\n",
-              worst, radius, run);
+  std::printf(
+      "    circle: one eq.-17 step vs the omega-DLA step: max difference %.2e (radius drift %.2e); whole runs differ "
+      "by %.2e after 5000 steps\n",
+      worst, radius, run);
   EXPECT_LT(worst, 4 * radius + 64 * std::numeric_limits<double>::epsilon());
   EXPECT_LT(run, 1e-7);
 }

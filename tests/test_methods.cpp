@@ -42,8 +42,8 @@ struct Final {
   RunReport rep;
 };
 template <class S>
-Final<S> run_to_end(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0,
-                    const Vec<double, S::n>& v0, double h, long steps) {
+Final<S> run_to_end(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+                    double h, long steps) {
   Final<S> f;
   const double E0 = energy(sys, q0, v0);
   f.rep = run_method(sys, spec, q0, v0, h, steps, [&](const Sample<S::n, S::m>& s) {
@@ -100,7 +100,9 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
       auto run_at = [&](double h, bool front) {
         const Final<S> f = run_to_end(sys, m.spec, q0, v0, h, std::lround(T / h));
         EXPECT_TRUE(f.rep.ok) << m.label() << " h " << h << ": " << f.rep.reason;
-        const auto at = [&](std::vector<double>& v, double x) { front ? (void)v.insert(v.begin(), x) : v.push_back(x); };
+        const auto at = [&](std::vector<double>& v, double x) {
+          front ? (void)v.insert(v.begin(), x) : v.push_back(x);
+        };
         at(hs, h);
         at(eq, f.rep.ok ? (f.q - qref).cwiseAbs().maxCoeff() : NAN);
         at(ev, f.rep.ok ? (f.v - vref).cwiseAbs().maxCoeff() : NAN);
@@ -129,8 +131,8 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
       }
       FAIL() << m.label() << ": too few points above the floor from the " << state << " state:" << errs;
     }
-    std::printf("    %-14s %s state, declared %d, fitted q %.3f, v %.3f, energy %s; q errors", m.label().c_str(), state, p,
-                *fq.order, *fv.order, fE.order ? std::to_string(*fE.order).c_str() : "-");
+    std::printf("    %-14s %s state, declared %d, fitted q %.3f, v %.3f, energy %s; q errors", m.label().c_str(), state,
+                p, *fq.order, *fv.order, fE.order ? std::to_string(*fE.order).c_str() : "-");
     for (double e : eq) std::printf(" %.2e", e);
     std::printf("\n");
     EXPECT_NEAR(*fq.order, p, tol) << m.label() << " (q)";
@@ -272,8 +274,8 @@ TYPED_TEST(MethodContract, DlaMultiplierIsTheIndexReducedMultiplier) {
   const S sys = make_system<S>();
   const double h = 0.005;
   double worst = 0, size = 0;
-  const RunReport rep = integrate(DlaStepper<S, AlphaDiscretization>(sys, AlphaDiscretization{0.5}),
-                                  S::default_q0(), S::default_v0(), h, 400, [&](const Sample<n, m>& s) {
+  const RunReport rep = integrate(DlaStepper<S, AlphaDiscretization>(sys, AlphaDiscretization{0.5}), S::default_q0(),
+                                  S::default_v0(), h, 400, [&](const Sample<n, m>& s) {
                                     if (s.k == 0) return true;
                                     Vec<double, m> lc;
                                     generic_acceleration(sys, s.q, s.v, &lc);
@@ -351,13 +353,13 @@ TYPED_TEST(MethodContract, AlphaAndSplitWithEqualAlphasGiveIdenticalRuns) {
   const S sys = make_system<S>();
   for (double a : {0.0, 0.25, 0.5, 1.0}) {
     std::vector<Vec<double, S::n>> qa, qs;
-    integrate(DlaStepper<S, AlphaDiscretization>(sys, AlphaDiscretization{a}), S::default_q0(), S::default_v0(),
-              0.2, 100, [&](const Sample<S::n, S::m>& s) {
+    integrate(DlaStepper<S, AlphaDiscretization>(sys, AlphaDiscretization{a}), S::default_q0(), S::default_v0(), 0.2,
+              100, [&](const Sample<S::n, S::m>& s) {
                 qa.push_back(s.q);
                 return true;
               });
-    integrate(DlaStepper<S, SplitDiscretization>(sys, SplitDiscretization{a, a}), S::default_q0(),
-              S::default_v0(), 0.2, 100, [&](const Sample<S::n, S::m>& s) {
+    integrate(DlaStepper<S, SplitDiscretization>(sys, SplitDiscretization{a, a}), S::default_q0(), S::default_v0(), 0.2,
+              100, [&](const Sample<S::n, S::m>& s) {
                 qs.push_back(s.q);
                 return true;
               });
@@ -390,8 +392,8 @@ TYPED_TEST(MethodContract, DiscretizationsAreTheirFormulas) {
       EXPECT_NEAR(discrete_lagrangian<S>(sys, AlphaDiscretization{a}, h, q0, q1), h * L(a), tol);  // eq. 9
       EXPECT_LE((discrete_constraint<S>(sys, AlphaDiscretization{a}, h, q0, q1) - W(a)).cwiseAbs().maxCoeff(),
                 1e-14 * (1 + v.cwiseAbs().maxCoeff()));  // eq. 13
-      EXPECT_NEAR(discrete_lagrangian<S>(sys, SymmetricDiscretization{a}, h, q0, q1),
-                  0.5 * h * (L(a) + L(1 - a)), tol);  // eq. 10
+      EXPECT_NEAR(discrete_lagrangian<S>(sys, SymmetricDiscretization{a}, h, q0, q1), 0.5 * h * (L(a) + L(1 - a)),
+                  tol);  // eq. 10
       EXPECT_LE((discrete_constraint<S>(sys, SymmetricDiscretization{a}, h, q0, q1) - 0.5 * (W(a) + W(1 - a)))
                     .cwiseAbs()
                     .maxCoeff(),

@@ -122,7 +122,8 @@ TEST(Mp06, VelocityFormKeepsThePhaseFormEnergyRoundOff) {
       phase.finish(y, lambda, &q, &p);
     }
     const auto z = vel.phase();
-    drift_vel = std::max(drift_vel, std::abs(hamiltonian<S, double>(sys, z.template head<n>(), z.template tail<n>()) - H0));
+    drift_vel =
+        std::max(drift_vel, std::abs(hamiltonian<S, double>(sys, z.template head<n>(), z.template tail<n>()) - H0));
     drift_phase = std::max(drift_phase, std::abs(hamiltonian<S, double>(sys, q, p) - H0));
   }
   std::printf("    max |H - H0| over t = 100: velocity form %.3g, phase form %.3g\n", drift_vel, drift_phase);
@@ -196,8 +197,7 @@ TYPED_TEST(Mp06SeparableTest, SeparableVelocityIsTheSystemsV) {
     }
     const auto z1 = fast.phase(), z2 = full.phase();
     EXPECT_LE((z1 - z2).cwiseAbs().maxCoeff(), 1e-12 * (1 + z1.cwiseAbs().maxCoeff())) << trial;
-    EXPECT_LE((fast.lambda() - full.lambda()).cwiseAbs().maxCoeff(),
-              1e-11 * (1 + fast.lambda().cwiseAbs().maxCoeff()))
+    EXPECT_LE((fast.lambda() - full.lambda()).cwiseAbs().maxCoeff(), 1e-11 * (1 + fast.lambda().cwiseAbs().maxCoeff()))
         << trial;
   }
   // The scenes with masses among their parameters draw M^-1 != I.
@@ -294,7 +294,8 @@ TYPED_TEST(Mp06SeparableTest, Mp06RoundingTermsAreTheResidualsResponseToQ1) {
     for (int a = 0; a < m; ++a) lj[a] = J(lambda[a], a);
     Vec<J, n> q1j, p1j, v1j;
     prob.template state<J>(lj, &q1j, &p1j, &v1j);
-    if (Mp06Stepper<S>::explicit_structure(rs)) EXPECT_TRUE((extra.array() == 0.0).all()) << S::name << " trial " << trial;
+    if (Mp06Stepper<S>::explicit_structure(rs))
+      EXPECT_TRUE((extra.array() == 0.0).all()) << S::name << " trial " << trial;
     Vec<double, m> fd = Vec<double, m>::Zero();
     for (int k = 0; k < n; ++k) {
       if ((q1j[k].v.array() == 0.0).all()) continue;  // a coordinate lambda does not move
@@ -354,8 +355,10 @@ TEST(Mp06, SleighResidualFloorIsTheRoundingOfQ1) {
       qk[k] = std::nextafter(qk[k], dir * std::numeric_limits<double>::infinity());
       spread = std::max(spread, std::abs((sys.omega<double>(qk) * v1)[0] - r1));
     }
-  std::printf("    one ulp of q1: residual moves by %.3g = %.1f eps of its terms (%.3g), %.2f eps of the rounding terms (%.3g)\n",
-              spread, spread / (kEps * terms[0]), terms[0], spread / (kEps * extra[0]), extra[0]);
+  std::printf(
+      "    one ulp of q1: residual moves by %.3g = %.1f eps of its terms (%.3g), %.2f eps of the rounding terms "
+      "(%.3g)\n",
+      spread, spread / (kEps * terms[0]), terms[0], spread / (kEps * extra[0]), extra[0]);
   EXPECT_GT(spread, 16 * kEps * terms[0]);
   EXPECT_LE(spread, kEps * extra[0] + 4 * kEps * terms[0]);
   for (const char* name : {"triple_jump", "suzuki5", "order6"}) {

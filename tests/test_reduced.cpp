@@ -64,11 +64,12 @@ void check_equivalence(const D& disc, double h, long steps) {
     worst_r = std::max(worst_r, (r - red.shape_of(qs[j])).cwiseAbs().maxCoeff() / scale);
     worst_s = std::max(worst_s, (s - red.group_of(qs[j])).cwiseAbs().maxCoeff() / scale);
     // pi is a difference quotient of positions, so its round-off floor is eps |q| / h.
-    worst_pi = std::max(worst_pi, (pi - red.reduced_momentum(qs[j], ps[j])).cwiseAbs().maxCoeff() /
-                                      (scale / h));
+    worst_pi = std::max(worst_pi, (pi - red.reduced_momentum(qs[j], ps[j])).cwiseAbs().maxCoeff() / (scale / h));
   }
-  std::printf("    %s h=%g: |r - r_DLA| %.2e, |s - s_DLA| %.2e (rel. to 1+|q|), |pi - pi_DLA| %.2e (rel. to (1+|q|)/h), residual %.2e\n",
-              S::name, h, worst_r, worst_s, worst_pi, worst_res);
+  std::printf(
+      "    %s h=%g: |r - r_DLA| %.2e, |s - s_DLA| %.2e (rel. to 1+|q|), |pi - pi_DLA| %.2e (rel. to (1+|q|)/h), "
+      "residual %.2e\n",
+      S::name, h, worst_r, worst_s, worst_pi, worst_res);
   EXPECT_LT(worst_r, 1e-12);
   EXPECT_LT(worst_s, 1e-12);
   EXPECT_LT(worst_pi, 1e-12);
@@ -128,7 +129,12 @@ TEST(Theorem56, ParticleForcesDoNotVanishSoTheRdlaIsNotThePlainVI) {
 TEST(Theorem56, RobotRdlaIsTheVariationalIntegratorOfLcOnEachLevelOfDeltaTheta) {
   for (int variant = 0; variant < 2; ++variant) {
     Robot sys;
-    if (variant == 1) { sys.mass = 2.0; sys.R = 0.7; sys.Iw = 0.2; sys.V0 = 3.0; }
+    if (variant == 1) {
+      sys.mass = 2.0;
+      sys.R = 0.7;
+      sys.Iw = 0.2;
+      sys.V0 = 3.0;
+    }
     const double h = 0.2;
     const auto rs = rdla_run(sys, h, 300, true);
     const double c = rs[1][0] - rs[0][0];
@@ -143,8 +149,8 @@ TEST(Theorem56, RobotRdlaIsTheVariationalIntegratorOfLcOnEachLevelOfDeltaTheta) 
       worst_c = std::max(worst_c, std::abs(beta_c * ((b - a) - (e - b)) / h - pot) / scale);
       worst_star = std::max(worst_star, std::abs(beta_star * ((b - a) - (e - b)) / h - pot) / scale);
     }
-    std::printf("    robot variant %d: |d theta - c| %.1e, DEL residual of L_c %.1e, of midpoint L* %.1e\n",
-                variant, worst_theta, worst_c, worst_star);
+    std::printf("    robot variant %d: |d theta - c| %.1e, DEL residual of L_c %.1e, of midpoint L* %.1e\n", variant,
+                worst_theta, worst_c, worst_star);
     EXPECT_LT(worst_theta, 1e-12);
     EXPECT_LT(worst_c, 1e-12);
     EXPECT_GT(worst_star, 1e-4);

@@ -38,7 +38,7 @@ TEST(Scene, NewMethodsAndCompositionsResolve) {
 
 struct Bad {
   const char* what;
-  const char* key;       // the key the message must name
+  const char* key;  // the key the message must name
   std::function<void(json&)> edit;
 };
 
@@ -62,10 +62,19 @@ TEST(Scene, RejectsBadInputNamingTheKey) {
       {"unknown system", "system", [](json& s) { s["system"] = "pendulum"; }},
       {"unknown method", "method", [](json& s) { s["method"] = "euler"; }},
       {"unknown discretization", "discretization", [](json& s) { s["discretization"] = "trapezoid"; }},
-      {"q0 too short", "q0", [](json& s) { s["q0"] = {1, 2}; }},
-      {"v0 too long", "v0", [](json& s) { s["v0"] = {0, 0, 0, 0}; }},
+      {"q0 too short", "q0",
+       [](json& s) {
+         s["q0"] = {1, 2};
+       }},
+      {"v0 too long", "v0",
+       [](json& s) {
+         s["v0"] = {0, 0, 0, 0};
+       }},
       {"q0 not an array", "q0", [](json& s) { s["q0"] = 3; }},
-      {"q0 entry a string", "q0[1]", [](json& s) { s["q0"] = {1, "a", 0}; }},
+      {"q0 entry a string", "q0[1]",
+       [](json& s) {
+         s["q0"] = {1, "a", 0};
+       }},
       {"alpha above 1", "alpha", [](json& s) { s["alpha"] = 1.0000001; }},
       {"alpha below 0", "alpha", [](json& s) { s["alpha"] = -1e-9; }},
       {"h zero", "h", [](json& s) { s["h"] = 0; }},
@@ -77,19 +86,44 @@ TEST(Scene, RejectsBadInputNamingTheKey) {
       {"steps negative", "steps", [](json& s) { s["steps"] = -5; }},
       {"steps fractional", "steps", [](json& s) { s["steps"] = 1.5; }},
       {"steps a string", "steps", [](json& s) { s["steps"] = "10"; }},
-      {"v0 off the constraint", "v0", [](json& s) { s["v0"] = {0.5, 1, 0.3}; }},
+      {"v0 off the constraint", "v0",
+       [](json& s) {
+         s["v0"] = {0.5, 1, 0.3};
+       }},
       {"unknown key", "stepz", [](json& s) { s["stepz"] = 3; }},
       {"missing method", "method", [](json& s) { s.erase("method"); }},
       {"missing h", "h", [](json& s) { s.erase("h"); }},
-      {"unknown parameter", "params.mass", [](json& s) { s["params"] = {{"mass", 2}}; }},
-      {"params not an object", "params", [](json& s) { s["params"] = {1, 2}; }},
+      {"unknown parameter", "params.mass",
+       [](json& s) {
+         s["params"] = {{"mass", 2}};
+       }},
+      {"params not an object", "params",
+       [](json& s) {
+         s["params"] = {1, 2};
+       }},
       {"tolerance zero", "tolerance", [](json& s) { s["tolerance"] = 0; }},
       {"output_every zero", "output_every", [](json& s) { s["output_every"] = 0; }},
       {"NaN entry", "v0[0]", [](json& s) { s["v0"][0] = std::nan(""); }},
-      {"composition of a non-symmetric DLA", "composition", [](json& s) { s["alpha"] = 0.25; s["composition"] = "triple_jump"; }},
-      {"composition of rk4", "composition", [](json& s) { s["method"] = "rk4"; s["composition"] = "order6"; }},
-      {"unknown composition", "composition", [](json& s) { s["method"] = "mp06"; s["composition"] = "order8"; }},
-      {"composition not a string", "composition", [](json& s) { s["method"] = "mp06"; s["composition"] = 4; }},
+      {"composition of a non-symmetric DLA", "composition",
+       [](json& s) {
+         s["alpha"] = 0.25;
+         s["composition"] = "triple_jump";
+       }},
+      {"composition of rk4", "composition",
+       [](json& s) {
+         s["method"] = "rk4";
+         s["composition"] = "order6";
+       }},
+      {"unknown composition", "composition",
+       [](json& s) {
+         s["method"] = "mp06";
+         s["composition"] = "order8";
+       }},
+      {"composition not a string", "composition",
+       [](json& s) {
+         s["method"] = "mp06";
+         s["composition"] = 4;
+       }},
       // make fuzz found this one: the message's dump() threw on invalid UTF-8.
       {"string with invalid UTF-8 (--set fallback)", "params.kx",
        [](json& s) { apply_override(&s, "params.kx=\x86\x86\x86"); }},
@@ -133,13 +167,34 @@ TEST(Scene, RobotResolvesDefaultsAndRejectsBadInput) {
   const json r = validate_scene(good_robot());
   EXPECT_EQ(r["params"], json::parse(R"({"m": 1.0, "I": 1.0, "Iw": 0.3333333333333333, "R": 1.0, "V0": 10.0})"));
   const std::vector<Bad> cases = {
-      {"q0 of particle length", "q0", [](json& s) { s["q0"] = {0, 0, 0}; }},
-      {"v0 too long", "v0", [](json& s) { s["v0"] = {1, 0, 1, 1, 0}; }},
-      {"v0 off the first constraint", "v0", [](json& s) { s["v0"] = {0.5, 0, 1, 1}; }},
-      {"v0 off the second constraint (turned wheels)", "v0", [](json& s) { s["q0"] = {0, 0, 1.0, 0}; }},
-      {"negative mass", "params.m", [](json& s) { s["params"] = {{"m", -1}}; }},
-      {"zero wheel radius", "params.R", [](json& s) { s["params"] = {{"R", 0}}; }},
-      {"particle parameter", "params.kx", [](json& s) { s["params"] = {{"kx", 1}}; }},
+      {"q0 of particle length", "q0",
+       [](json& s) {
+         s["q0"] = {0, 0, 0};
+       }},
+      {"v0 too long", "v0",
+       [](json& s) {
+         s["v0"] = {1, 0, 1, 1, 0};
+       }},
+      {"v0 off the first constraint", "v0",
+       [](json& s) {
+         s["v0"] = {0.5, 0, 1, 1};
+       }},
+      {"v0 off the second constraint (turned wheels)", "v0",
+       [](json& s) {
+         s["q0"] = {0, 0, 1.0, 0};
+       }},
+      {"negative mass", "params.m",
+       [](json& s) {
+         s["params"] = {{"m", -1}};
+       }},
+      {"zero wheel radius", "params.R",
+       [](json& s) {
+         s["params"] = {{"R", 0}};
+       }},
+      {"particle parameter", "params.kx",
+       [](json& s) {
+         s["params"] = {{"kx", 1}};
+       }},
   };
   for (const auto& c : cases) {
     json s = good_robot();
@@ -198,7 +253,8 @@ TEST(Scene, RunRecordsEveryPointAndTheSummary) {
   EXPECT_EQ(r["lambda"][0].size(), 1u);
   // The summary's maxima cover every point, the recorded ones included.
   double recorded = 0;
-  for (const auto& e : r["energy"]) recorded = std::max(recorded, std::abs(e.get<double>() - r["energy"][0].get<double>()));
+  for (const auto& e : r["energy"])
+    recorded = std::max(recorded, std::abs(e.get<double>() - r["energy"][0].get<double>()));
   EXPECT_GE(r["summary"]["max_abs_energy_error"].get<double>(), recorded);
   // Same run at stride 1: the summary is identical.
   s["output_every"] = 1;

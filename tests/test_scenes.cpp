@@ -67,12 +67,12 @@ TEST(ContactOscillators, FirstIntegralsAreConservedByTheReference) {
   EXPECT_NEAR(I0[1], 1.0, 1e-15);  // R = H - H_y: H = 3/2 (the default state's definition)
   EXPECT_NEAR(energy(sys, q0, v0), 1.5, 1e-15);
   double worst = 0;
-  const RunReport rep = integrate(ReferenceStepper<ContactOscillator>(sys), q0, v0, 0.5, 200,
-                                  [&](const Sample<3, 1>& s) {
-                                    const auto I = sys.first_integrals(s.q, s.v);
-                                    worst = std::max({worst, std::abs(I[0] - I0[0]), std::abs(I[1] - I0[1])});
-                                    return true;
-                                  });
+  const RunReport rep =
+      integrate(ReferenceStepper<ContactOscillator>(sys), q0, v0, 0.5, 200, [&](const Sample<3, 1>& s) {
+        const auto I = sys.first_integrals(s.q, s.v);
+        worst = std::max({worst, std::abs(I[0] - I0[0]), std::abs(I[1] - I0[1])});
+        return true;
+      });
   ASSERT_TRUE(rep.ok) << rep.reason;
   EXPECT_LT(worst, 1e-9);
   // y(t) = cos t exactly: y decouples.
@@ -144,7 +144,8 @@ TYPED_TEST(SceneFileTest, SceneFileHoldsTheDefaults) {
     EXPECT_EQ(sc["v0"][i].template get<double>(), S::default_v0()[i]) << S::name << " v0[" << i << "]";
   }
   const S sys;
-  for (const auto& p : S::parameters()) EXPECT_EQ(sc["params"][p.name].template get<double>(), sys.*(p.member)) << p.name;
+  for (const auto& p : S::parameters())
+    EXPECT_EQ(sc["params"][p.name].template get<double>(), sys.*(p.member)) << p.name;
 }
 
 // The runner reports the contact oscillators' first integrals at every recorded point.

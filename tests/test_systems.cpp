@@ -23,10 +23,10 @@ TYPED_TEST(SystemTest, AutodiffPartialsMatchFiniteDifferences) {
     for (int i = 0; i < n; ++i) {
       Vec<double, n> e = Vec<double, n>::Zero();
       e[i] = eps;
-      const double fq = (sys.template lagrangian<double>(q + e, v) -
-                         sys.template lagrangian<double>(q - e, v)) / (2 * eps);
-      const double fv = (sys.template lagrangian<double>(q, v + e) -
-                         sys.template lagrangian<double>(q, v - e)) / (2 * eps);
+      const double fq =
+          (sys.template lagrangian<double>(q + e, v) - sys.template lagrangian<double>(q - e, v)) / (2 * eps);
+      const double fv =
+          (sys.template lagrangian<double>(q, v + e) - sys.template lagrangian<double>(q, v - e)) / (2 * eps);
       EXPECT_NEAR(dq[i], fq, 1e-8 * (1 + std::abs(fq)));
       EXPECT_NEAR(dv[i], fv, 1e-8 * (1 + std::abs(fv)));
     }
@@ -49,8 +49,7 @@ TYPED_TEST(SystemTest, OmegaJetDerivativesMatchFiniteDifferences) {
     for (int k = 0; k < n; ++k) {
       Vec<double, n> e = Vec<double, n>::Zero();
       e[k] = eps;
-      const Mat<double, m, n> fd =
-          (sys.template omega<double>(q + e) - sys.template omega<double>(q - e)) / (2 * eps);
+      const Mat<double, m, n> fd = (sys.template omega<double>(q + e) - sys.template omega<double>(q - e)) / (2 * eps);
       for (int a = 0; a < m; ++a)
         for (int j = 0; j < n; ++j) {
           EXPECT_NEAR(Wj(a, j).v[k], fd(a, j), 1e-8);
@@ -148,11 +147,10 @@ TYPED_TEST(SystemTest, EnergyIsConservedAlongTheBenchmark) {
   random_state<S>(rng, &q, &v);
   const double E0 = energy(sys, q, v);
   double worst = 0;
-  integrate(ReferenceStepper<S>(sys), q, v, 0.1, 200,
-                      [&](const Sample<S::n, S::m>& s) {
-                        worst = std::max(worst, std::abs(energy(sys, s.q, s.v) - E0));
-                        return true;
-                      });
+  integrate(ReferenceStepper<S>(sys), q, v, 0.1, 200, [&](const Sample<S::n, S::m>& s) {
+    worst = std::max(worst, std::abs(energy(sys, s.q, s.v) - E0));
+    return true;
+  });
   EXPECT_LT(worst, 1e-9 * (1 + std::abs(E0)));
 }
 

@@ -158,8 +158,8 @@ class Composed {
       if (!s.ok()) {
         total.status = SolveStatus::kFailed;
         total.failure = s.failure;
-        total.message = c_.name + " stage " + std::to_string(i + 1) + " of " + std::to_string(c_.gamma.size()) +
-                        ": " + s.message;
+        total.message =
+            c_.name + " stage " + std::to_string(i + 1) + " of " + std::to_string(c_.gamma.size()) + ": " + s.message;
         return total;
       }
     }

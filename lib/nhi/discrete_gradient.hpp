@@ -66,8 +66,8 @@ struct DiscreteGradientProblem {
   // together, it is all that is left of that row's size).  *c_out (may be
   // null) gets Gonzalez's coefficient c (0 when dz = 0).
   template <class T>
-  void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp,
-                         VecN* sq = nullptr, VecN* sp = nullptr, T* c_out = nullptr) const {
+  void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp, VecN* sq = nullptr,
+                         VecN* sp = nullptr, T* c_out = nullptr) const {
     const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1), pb = cst<T>(0.5) * (p0.template cast<T>() + p1);
     const Vec<T, n> gq = -force(sys, qb, pb), gp = velocity(sys, qb, pb);
     const Vec<T, n> dq = q1 - q0.template cast<T>(), dp = p1 - p0.template cast<T>();
@@ -105,8 +105,8 @@ struct DiscreteGradientProblem {
     const Mat<T, m, n> Wb = sys.template omega<T>(qb);
     const Vec<T, n> fc = Wb.transpose() * lambda;
     for (int i = 0; i < n; ++i) {
-      (*r)[i] = q1[i] - cst<T>(q0[i]) - cst<T>(h) * Dp[i];                        // (q1 - q0)/h = gradbar_p H
-      (*r)[n + i] = p1[i] - cst<T>(p0[i]) + cst<T>(h) * (Dq[i] - fc[i]);          // (p1 - p0)/h = -gradbar_q H + omega^T lambda
+      (*r)[i] = q1[i] - cst<T>(q0[i]) - cst<T>(h) * Dp[i];                // (q1 - q0)/h = gradbar_p H
+      (*r)[n + i] = p1[i] - cst<T>(p0[i]) + cst<T>(h) * (Dq[i] - fc[i]);  // (p1 - p0)/h = -gradbar_q H + omega^T lambda
       if (terms) {
         (*terms)[i] = std::abs(value_of(q1[i])) + std::abs(q0[i]) + std::abs(h) * sp[i];
         double fs = 0;
@@ -240,7 +240,8 @@ class DiscreteGradientStepper {
       const Mat<double, n, n> hKM = (0.25 * hh * hh) * (*K_ * Minv_);
       const Mat<double, n, n> G = Mat<double, n, n>::Identity() - hKM;
       const double det = G.determinant();
-      if (hKM.cwiseAbs().maxCoeff() >= 5e-4 && std::isfinite(det) && std::abs(det) > 0.5) {  // (h^2/4) K small against M
+      if (hKM.cwiseAbs().maxCoeff() >= 5e-4 && std::isfinite(det) &&
+          std::abs(det) > 0.5) {  // (h^2/4) K small against M
         cv.Q = G.inverse();
         cv.MQ = Minv_ * cv.Q;
         cv.ok = all_finite(cv.Q);

@@ -42,7 +42,7 @@ void DiscreteGradientStepper<S>::start(const VecN& q0, const VecN& v0) {
 
 template <class S>
 StepSummary DiscreteGradientStepper<S>::map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1,
-                                             VecM* lambda) const {
+                                            VecM* lambda) const {
   const Problem prob(sys_, h, q0, p0);
   // Guess: an explicit Stoermer-Verlet-like step with the last multiplier
   // (second order when lambda is), so Newton starts close.
@@ -245,7 +245,8 @@ bool DiscreteGradientStepper<S>::passes(const Problem& prob, Vec<double, Problem
     } else {
       if constexpr (m > 0) {
         Mat<double, m, m> A;
-        for (int a = 0; a < m; ++a) A.col(a) = W * velocity<S, double>(sys_, qb, VecN((0.5 * h) * W.row(a).transpose()));
+        for (int a = 0; a < m; ++a)
+          A.col(a) = W * velocity<S, double>(sys_, qb, VecN((0.5 * h) * W.row(a).transpose()));
         l = -(A.inverse() * (W * VecN(velocity<S, double>(sys_, qb, VecN(p0 - (0.5 * h) * Dq)) + cp)));
       }
       p1n = p0 - h * (Dq - W.transpose() * l);
@@ -258,7 +259,8 @@ bool DiscreteGradientStepper<S>::passes(const Problem& prob, Vec<double, Problem
     const VecN fs = W.cwiseAbs().transpose() * l.cwiseAbs();
     const VecN bound_q = kSettled * (q0.cwiseAbs() + q1n.cwiseAbs() + std::abs(h) * sp),
                bound_p = kSettled * (p0.cwiseAbs() + p1n.cwiseAbs() + std::abs(h) * (sq + fs));
-    const bool fixed = ((q1n - q1).cwiseAbs() - bound_q).maxCoeff() <= 0 && ((p1n - p1).cwiseAbs() - bound_p).maxCoeff() <= 0;
+    const bool fixed =
+        ((q1n - q1).cwiseAbs() - bound_q).maxCoeff() <= 0 && ((p1n - p1).cwiseAbs() - bound_p).maxCoeff() <= 0;
     // No longer contracting: at round-off (the residual check judges) or diverging.
     if (!fixed && pass > 0 && !(move <= 0.5 * last_move)) {
       if (!(last_move <= kStall * size)) return false;

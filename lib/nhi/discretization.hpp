@@ -77,8 +77,7 @@ inline Vec<T, N> interpolate(const Vec<T, N>& q0, const Vec<T, N>& q1, double c)
 
 // L_d(q0, q1) (eq. 9 / 10).
 template <class S, class D, class T>
-inline T discrete_lagrangian(const S& sys, const D& disc, double h, const Vec<T, S::n>& q0,
-                             const Vec<T, S::n>& q1) {
+inline T discrete_lagrangian(const S& sys, const D& disc, double h, const Vec<T, S::n>& q0, const Vec<T, S::n>& q1) {
   const Vec<T, S::n> v = (q1 - q0) / cst<T>(h);
   T Ld = cst<T>(0.0);
   for (const Node& nd : disc.nodes())
@@ -92,9 +91,8 @@ inline T discrete_lagrangian(const S& sys, const D& disc, double h, const Vec<T,
 // Either pointer may be null.  This is the hot path of the DLA step; the tests
 // check it against discrete_lagrangian_slot() below (autodiff of L_d itself).
 template <class S, class D, class T>
-inline void discrete_lagrangian_slots(const S& sys, const D& disc, double h,
-                                      const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
-                                      Vec<T, S::n>* D1, Vec<T, S::n>* D2) {
+inline void discrete_lagrangian_slots(const S& sys, const D& disc, double h, const Vec<T, S::n>& q0,
+                                      const Vec<T, S::n>& q1, Vec<T, S::n>* D1, Vec<T, S::n>* D2) {
   constexpr int n = S::n;
   Vec<T, n> v;
   for (int i = 0; i < n; ++i) v[i] = divide(T(q1[i] - q0[i]), h);
@@ -115,8 +113,8 @@ inline void discrete_lagrangian_slots(const S& sys, const D& disc, double h,
 // T = Jet<double, n> over q1 (as in the DLA step) this is a Jet of Jets and
 // gives D2 D1 L_d, the top-left block of the matrix (7), exactly.
 template <int slot, class S, class D, class T>
-inline Vec<T, S::n> discrete_lagrangian_slot(const S& sys, const D& disc, double h,
-                                             const Vec<T, S::n>& q0, const Vec<T, S::n>& q1) {
+inline Vec<T, S::n> discrete_lagrangian_slot(const S& sys, const D& disc, double h, const Vec<T, S::n>& q0,
+                                             const Vec<T, S::n>& q1) {
   static_assert(slot == 1 || slot == 2, "slot is 1 or 2");
   constexpr int n = S::n;
   using J = ceres::Jet<T, n>;
@@ -136,9 +134,8 @@ inline Vec<T, S::n> discrete_lagrangian_slot(const S& sys, const D& disc, double
 // omega_at(k, q_c) gives omega(q_c) at the k-th constraint node (a caller
 // may have it at hand: DlaStepper's passes).
 template <class S, class D, class T, class OmegaAt>
-inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& disc, double h,
-                                             const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
-                                             Vec<double, S::m>* scale = nullptr) {
+inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& disc, double h, const Vec<T, S::n>& q0,
+                                             const Vec<T, S::n>& q1, Vec<double, S::m>* scale = nullptr) {
   Vec<T, S::n> v;
   for (int i = 0; i < S::n; ++i) v[i] = divide(T(q1[i] - q0[i]), h);
   Vec<T, S::m> w;
@@ -158,11 +155,10 @@ inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& d
 }
 
 template <class S, class D, class T>
-inline Vec<T, S::m> discrete_constraint(const S& sys, const D& disc, double h,
-                                        const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
-                                        Vec<double, S::m>* scale = nullptr) {
-  return discrete_constraint_with<S, D, T>([&](int, const Vec<T, S::n>& q) { return sys.template omega<T>(q); },
-                                           disc, h, q0, q1, scale);
+inline Vec<T, S::m> discrete_constraint(const S& sys, const D& disc, double h, const Vec<T, S::n>& q0,
+                                        const Vec<T, S::n>& q1, Vec<double, S::m>* scale = nullptr) {
+  return discrete_constraint_with<S, D, T>([&](int, const Vec<T, S::n>& q) { return sys.template omega<T>(q); }, disc,
+                                           h, q0, q1, scale);
 }
 
 }  // namespace nhi

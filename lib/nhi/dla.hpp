@@ -27,11 +27,11 @@
 
 #include <array>
 #include <limits>
+#include <optional>
+#include <string>
 #include <tuple>
 #include <type_traits>
 #include <utility>
-#include <optional>
-#include <string>
 
 #include "nhi/discretization.hpp"
 #include "nhi/hamiltonian.hpp"
@@ -55,7 +55,8 @@ struct OmegaMemo {
   std::array<Vec<double, n>, kNodes> q;
   std::array<Mat<double, m, n>, kNodes> W;
   std::array<bool, kNodes> valid{};
-  explicit OmegaMemo(const S& sys) : reads(omega_reads(sys)) {  // (q, W zero: a memo copies cleanly before its first use)
+  explicit OmegaMemo(const S& sys)
+      : reads(omega_reads(sys)) {  // (q, W zero: a memo copies cleanly before its first use)
     for (auto& x : q) x.setZero();
     for (auto& w : W) w.setZero();
   }
@@ -138,8 +139,7 @@ struct DlaStepProblem {
   // r = (p_k + D1 L_d(q_k, q1) - W^T lambda, omega_d(q_k, q1) [, g(q1)]);
   // *terms gets, per row, the sum of the magnitudes of the terms r_i adds up.
   template <class T>
-  void residual(const Vec<T, n>& q1, const Vec<T, mc>& lambda, Vec<T, n + mc>* r,
-                Vec<double, n + mc>* terms) const {
+  void residual(const Vec<T, n>& q1, const Vec<T, mc>& lambda, Vec<T, n + mc>* r, Vec<double, n + mc>* terms) const {
     const Vec<T, n> q0 = q_curr.template cast<T>();
     Vec<T, n> D1;
     if constexpr (std::is_same_v<T, double>) {
@@ -157,7 +157,8 @@ struct DlaStepProblem {
         if (memo) return memo->at(sys, k, qc);
       return sys.template omega<T>(qc);
     };
-    const Vec<T, m> wd = discrete_constraint_with<S, D, T>(omega_at, disc, h, q0, q1, terms ? &cscale : nullptr);  // eq. 13 / 14
+    const Vec<T, m> wd =
+        discrete_constraint_with<S, D, T>(omega_at, disc, h, q0, q1, terms ? &cscale : nullptr);  // eq. 13 / 14
     for (int i = 0; i < n; ++i) {
       T force = cst<T>(0.0);
       for (int a = 0; a < mc; ++a) force += scale(lambda[a], W_t(i, a));
@@ -208,8 +209,8 @@ class DlaMap {
   // Wt (may be null): force_forms(q_curr)^T, if the caller has it; memo (may
   // be null): omega at the constraint nodes of earlier evaluations.
   template <class Polish = typename NewtonSolver<Problem>::NoPolish>
-  StepSummary step(const VecN& q_curr, const VecN& p_curr, const VecN& q_guess, VecN* q_next,
-                   VecM* lambda, VecN* p_next, bool check_guess = false, const Polish& polish = {},
+  StepSummary step(const VecN& q_curr, const VecN& p_curr, const VecN& q_guess, VecN* q_next, VecM* lambda,
+                   VecN* p_next, bool check_guess = false, const Polish& polish = {},
                    const Mat<double, n, mc>* Wt = nullptr, typename Problem::Memo* memo = nullptr) const {
     Problem prob(sys_, disc_, h_, q_curr, p_curr, Wt);
     prob.memo = memo;
@@ -237,8 +238,8 @@ class DlaMap {
   }
 
   // Relative residual of eq. (6) at (q_next, lambda); *r_out gets the residual.
-  double relative_residual(const VecN& q_curr, const VecN& p_curr, const VecN& q_next,
-                           const VecM& lambda, VecX* r_out = nullptr) const {
+  double relative_residual(const VecN& q_curr, const VecN& p_curr, const VecN& q_next, const VecM& lambda,
+                           VecX* r_out = nullptr) const {
     const Problem prob(sys_, disc_, h_, q_curr, p_curr);
     return NewtonSolver<Problem>(prob, options_).relative_residual(q_next, lambda, r_out);
   }
@@ -431,7 +432,8 @@ class DlaStepper {
           const Mat<double, n, n> MhkK = Minv_ * c.hkK;
           const Mat<double, n, n> G = Mat<double, n, n>::Identity() - MhkK;  // M^-1 (M - h^2 kappa K)
           const double det = G.determinant();
-          if (MhkK.cwiseAbs().maxCoeff() >= 1e-6 && std::isfinite(det) && std::abs(det) > 0.5) {  // h^2 kappa K small against M
+          if (MhkK.cwiseAbs().maxCoeff() >= 1e-6 && std::isfinite(det) &&
+              std::abs(det) > 0.5) {  // h^2 kappa K small against M
             c.P = G.inverse() * Minv_;
             c.ok = all_finite(c.P);
           }
@@ -452,7 +454,6 @@ class DlaStepper {
   }
 
  public:
-
   // The passes of next_guess; kNewton: with the curvature of a potential of
   // one coordinate (a separate instantiation, so that the other passes
   // compile without it: a runtime branch in one shared loop makes the
@@ -530,7 +531,7 @@ class DlaStepper {
           if (std::abs(1.0 - z[r]) > 0.5) zs = 1.0 / (1.0 - z[r]);
         }
         VecN vfree;  // the plain pass's V(qbar, rhs)
-        if (gs_) {  // (then kappa = 0: neither curvature applies, the pass is the plain one below)
+        if (gs_) {   // (then kappa = 0: neither curvature applies, the pass is the plain one below)
           plain_forms(qbar);
           // Gauss-Seidel: in a coordinate whose row of V(q, W^T) is zero (one
           // the constraint force does not move) this pass's q1 is
@@ -703,10 +704,11 @@ class DlaStepper {
   // P = (M - h^2 kappa K)^-1, hkK = h^2 kappa K for a step size (curv_).
   Mat<double, n, n> Minv_ = Mat<double, n, n>::Zero();
   double kappa_ = 0;
-  bool affine_potential_force_ = false;  // dL/dq affine in q (K constant, maybe 0)
-  std::optional<Mat<double, n, n>> K_;   // K when constant and not 0
+  bool affine_potential_force_ = false;             // dL/dq affine in q (K constant, maybe 0)
+  std::optional<Mat<double, n, n>> K_;              // K when constant and not 0
   mutable typename Map::Problem::Memo omega_memo_;  // omega at the constraint nodes (OmegaMemo)
-  mutable Mat<double, n, Map::mc> guess_Wt_ = Mat<double, n, Map::mc>::Zero();  // force_forms(q_{k+1})^T, by next_guess (for the solve and polish())
+  mutable Mat<double, n, Map::mc> guess_Wt_ =
+      Mat<double, n, Map::mc>::Zero();  // force_forms(q_{k+1})^T, by next_guess (for the solve and polish())
   struct Curvature {
     Mat<double, n, n> P = Mat<double, n, n>::Zero(), hkK = Mat<double, n, n>::Zero();
     bool ok = false;
@@ -720,12 +722,12 @@ class DlaStepper {
   double h_ = 0, h_prev_ = 0;
   bool passes_settle_ = false;  // constraint_force_misses_omega (separable systems)
   bool gs_ = false;             // passes_settle_ and kappa = 0: one pass after an accepted guess
-  bool accepted_ = false;  // did the residual check accept the last step's guess?
+  bool accepted_ = false;       // did the residual check accept the last step's guess?
   // The last pass's matrices for polish(): Omega, (Omega G W^T)^-1, and G = P or M^-1 (W^T: guess_Wt_).
   mutable Mat<double, Map::mc, n> polish_Om_ = Mat<double, Map::mc, n>::Zero();
   mutable Mat<double, Map::mc, Map::mc> polish_Sinv_ = Mat<double, Map::mc, Map::mc>::Zero();
   mutable bool polish_curved_ = false, polish_ok_ = false;
-  mutable bool polish_lazy_ = false;  // polish_Sinv_ is still to be taken (a Newton pass)
+  mutable bool polish_lazy_ = false;      // polish_Sinv_ is still to be taken (a Newton pass)
   mutable VecN polish_z_ = VecN::Zero();  // z / (1 - z_r) of the last pass, and r (-1: none)
   mutable int polish_zr_ = -1;
   // The one coordinate the potential reads when the passes take its curvature (-1: they do not).

@@ -61,11 +61,11 @@ StepSummary DlaStepper<S, D>::step(double h) {
   bool settled = false;
   const bool accepted_last = accepted_;
   predict(h, &guess, &lambda_guess,
-             curvature_coordinate_ >= 0 ? kNewtonPasses
-             : gs_ && accepted_last      ? 1
-             : accepted_last || steps_ % 8 != 0 ? kMinPasses
-                                                : kMaxPasses,
-             &settled, true);
+          curvature_coordinate_ >= 0         ? kNewtonPasses
+          : gs_ && accepted_last             ? 1
+          : accepted_last || steps_ % 8 != 0 ? kMinPasses
+                                             : kMaxPasses,
+          &settled, true);
   const bool predicted = refines(h);  // next_guess refined q
   if (predicted) plain = extrapolation(h);
   const VecM lambda_plain = lambda_;
@@ -105,8 +105,8 @@ StepSummary DlaStepper<S, D>::step(double h) {
   if (st.status != SolveStatus::kConverged || !all_finite(q_next_)) {
     if (st.status == SolveStatus::kConverged) st.failure = FailureKind::kNonFinite;
     st.status = SolveStatus::kFailed;
-    st.message = "step solve for q_" + std::to_string(steps_) + " did not converge: " +
-                 (st.message.empty() ? "non-finite state" : st.message);
+    st.message = "step solve for q_" + std::to_string(steps_) +
+                 " did not converge: " + (st.message.empty() ? "non-finite state" : st.message);
   }
   return st;
 }
@@ -118,8 +118,8 @@ void DlaStepper<S, D>::sample(Sample<n, m>* s) const {
   s->v = steps_ == 1 ? v0_ : VecN((q_next_ - q_prev_) / (h_prev_ + h_));
   s->p = p_curr_;
   s->lambda = lambda_.template head<m>();
-  s->discrete_constraint = discrete_constraint<S, D, double>(map_.system(), map_.discretization(), h_,
-                                                             q_curr_, q_next_);
+  s->discrete_constraint =
+      discrete_constraint<S, D, double>(map_.system(), map_.discretization(), h_, q_curr_, q_next_);
 }
 
 template <class S, class D>

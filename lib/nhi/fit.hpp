@@ -28,9 +28,9 @@ inline double loglog_slope(const std::vector<double>& x, const std::vector<doubl
 // the asymptotic regime.  Local orders are log(e_{j-1}/e_j) / log(h_{j-1}/h_j)
 // between neighbours that both ran, where e_j is above the floor.
 struct OrderFit {
-  std::vector<double> h, error;               // the points fitted
-  std::optional<double> order;                // none with fewer than 3 points
-  std::vector<std::optional<double>> local;   // h.size() - 1 entries
+  std::vector<double> h, error;              // the points fitted
+  std::optional<double> order;               // none with fewer than 3 points
+  std::vector<std::optional<double>> local;  // h.size() - 1 entries
 };
 
 //
@@ -55,8 +55,7 @@ inline OrderFit fit_order(const std::vector<double>& hs, const std::vector<doubl
     }
   }
   auto order_at = [&](size_t j) { return std::log(f.error[j - 1] / f.error[j]) / std::log(f.h[j - 1] / f.h[j]); };
-  while (drop_floor_tail && f.h.size() >= 4 &&
-         std::abs(order_at(f.h.size() - 1) - order_at(f.h.size() - 2)) > 0.5) {
+  while (drop_floor_tail && f.h.size() >= 4 && std::abs(order_at(f.h.size() - 1) - order_at(f.h.size() - 2)) > 0.5) {
     f.h.pop_back();
     f.error.pop_back();
   }

@@ -38,8 +38,8 @@ struct has_velocity : std::false_type {};
 template <class S, class T>
 struct has_velocity<S, T,
                     std::void_t<decltype(std::declval<const S&>().template velocity<T>(
-                        std::declval<const Vec<T, S::n>&>(), std::declval<const Vec<T, S::n>&>()))>>
-    : std::true_type {};
+                        std::declval<const Vec<T, S::n>&>(), std::declval<const Vec<T, S::n>&>()))>> : std::true_type {
+};
 
 // V(q, p) for L quadratic in v, from the partials alone (see the top of this file).
 template <class S, class T>

@@ -15,7 +15,7 @@
 
 // PREFIX template class X<S>; for every stepper the library compiles for S
 // (PREFIX: extern for the declarations, empty for the definitions).
-#define NHI_STEPPER_INSTANCES(PREFIX, S)                              \
+#define NHI_STEPPER_INSTANCES(PREFIX, S)                                  \
   PREFIX template class nhi::DlaStepper<S, nhi::AlphaDiscretization>;     \
   PREFIX template class nhi::DlaStepper<S, nhi::SymmetricDiscretization>; \
   PREFIX template class nhi::DlaStepper<S, nhi::SplitDiscretization>;     \

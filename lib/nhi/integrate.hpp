@@ -19,8 +19,8 @@
 namespace nhi {
 
 template <class Stepper, class Observer>
-RunReport integrate(Stepper& stepper, const Vec<double, Stepper::n>& q0, const Vec<double, Stepper::n>& v0,
-                    double h, long steps, Observer&& observe) {
+RunReport integrate(Stepper& stepper, const Vec<double, Stepper::n>& q0, const Vec<double, Stepper::n>& v0, double h,
+                    long steps, Observer&& observe) {
   constexpr int n = Stepper::n, m = Stepper::m;
   RunReport rep;
   stepper.start(q0, v0);

@@ -14,7 +14,7 @@ struct MethodSpec {
   std::string kind = "dla";              // a Methods name: "dla", "rk4", "benchmark", "mp06", ...
   std::string discretization = "alpha";  // DLA: "alpha" or "symmetric"
   double alpha = 0.5;
-  double tolerance = 1e-12;  // implicit methods: relative residual; the reference: CVODE rtol = atol
+  double tolerance = 1e-12;          // implicit methods: relative residual; the reference: CVODE rtol = atol
   std::string composition = "none";  // symmetric methods: composition.hpp
 
   // The one label scheme: "dla a=0.5", "dla-sym a=0", "rk4", "reference",

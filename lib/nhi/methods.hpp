@@ -25,10 +25,10 @@
 #include "nhi/discrete_gradient.hpp"
 #include "nhi/dla_composition.hpp"
 #include "nhi/integrate.hpp"
-#include "nhi/reference.hpp"
-#include "nhi/rk4.hpp"
 #include "nhi/method_spec.hpp"
 #include "nhi/mp06.hpp"
+#include "nhi/reference.hpp"
+#include "nhi/rk4.hpp"
 #include "nhi/run.hpp"
 #include "nhi/typelist.hpp"
 
@@ -75,9 +75,15 @@ struct DlaMethod {
     };
     StudyEntry tj = dla("alpha", 0.5, "main"), tj_sym = dla("symmetric", 0.0, "variant");
     tj.spec.composition = tj_sym.spec.composition = "triple_jump";
-    return {dla("alpha", 0.5, "main"),     dla("symmetric", 0.0, "main"),   dla("alpha", 0.0, "variant"),
-            dla("alpha", 0.25, "variant"), dla("alpha", 0.75, "variant"),   dla("alpha", 1.0, "variant"),
-            dla("symmetric", 0.25, "variant"), tj, tj_sym};
+    return {dla("alpha", 0.5, "main"),
+            dla("symmetric", 0.0, "main"),
+            dla("alpha", 0.0, "variant"),
+            dla("alpha", 0.25, "variant"),
+            dla("alpha", 0.75, "variant"),
+            dla("alpha", 1.0, "variant"),
+            dla("symmetric", 0.25, "variant"),
+            tj,
+            tj_sym};
   }
 };
 

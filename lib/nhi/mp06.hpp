@@ -40,8 +40,7 @@ namespace nhi {
 // the solver's residual scale; shared by the three forms below and by
 // Mp06Stepper::explicit_map's residual check.
 template <class T, int m, int n, int N>
-void mp06_constraint_rows(const Mat<T, m, n>& W1, const Vec<T, n>& v1, int first, Vec<T, N>* r,
-                          Vec<double, N>* terms) {
+void mp06_constraint_rows(const Mat<T, m, n>& W1, const Vec<T, n>& v1, int first, Vec<T, N>* r, Vec<double, N>* terms) {
   for (int a = 0; a < m; ++a) {
     T c = cst<T>(0.0);
     double cs = 0;
@@ -65,8 +64,8 @@ struct Mp06PhaseProblem {
 
   const S& sys;
   double h;
-  VecN p0, q_half, F0;     // F0 = F(q_half, p0)
-  Mat<double, ny, nl> W_t; // [0; h omega(q_half)^T]
+  VecN p0, q_half, F0;      // F0 = F(q_half, p0)
+  Mat<double, ny, nl> W_t;  // [0; h omega(q_half)^T]
 
   Mp06PhaseProblem(const S& s, double hh, const VecN& q0, const VecN& p) : sys(s), h(hh), p0(p) {
     q_half = q0 + 0.5 * h * velocity<S, double>(sys, q0, p0);
@@ -84,8 +83,7 @@ struct Mp06PhaseProblem {
   }
 
   template <class T>
-  void residual(const Vec<T, ny>& y, const Vec<T, nl>& lambda, Vec<T, ny + nl>* r,
-                Vec<double, ny + nl>* terms) const {
+  void residual(const Vec<T, ny>& y, const Vec<T, nl>& lambda, Vec<T, ny + nl>* r, Vec<double, ny + nl>* terms) const {
     const Vec<T, n> q1 = y.template head<n>(), p1 = y.template tail<n>();
     const Vec<T, n> v1 = velocity(sys, q1, p1);
     const Vec<T, n> F1 = force(sys, Vec<T, n>(q_half.template cast<T>()), p1);
@@ -145,8 +143,8 @@ struct Mp06Problem {
 
   const S& sys;
   double h;
-  VecN p0, q_half, F0;     // F0 = F(q_half, p0)
-  Mat<double, ny, nl> W_t; // h omega(q_half)^T
+  VecN p0, q_half, F0;      // F0 = F(q_half, p0)
+  Mat<double, ny, nl> W_t;  // h omega(q_half)^T
 
   Mp06Problem(const S& s, double hh, const VecN& q0, const VecN& p) : sys(s), h(hh), p0(p) {
     q_half = q0 + 0.5 * h * velocity<S, double>(sys, q0, p0);
@@ -159,8 +157,7 @@ struct Mp06Problem {
   Vec<double, ny> y_scale(const Vec<double, ny>& v1) const { return v1.cwiseAbs(); }
 
   template <class T>
-  void residual(const Vec<T, ny>& v1, const Vec<T, nl>& lambda, Vec<T, ny + nl>* r,
-                Vec<double, ny + nl>* terms) const {
+  void residual(const Vec<T, ny>& v1, const Vec<T, nl>& lambda, Vec<T, ny + nl>* r, Vec<double, ny + nl>* terms) const {
     Vec<T, n> q1;
     for (int i = 0; i < n; ++i) q1[i] = cst<T>(q_half[i]) + scale(v1[i], 0.5 * h);
     Vec<T, n> Lq, p1;
@@ -215,9 +212,9 @@ struct Mp06SeparableProblem {
   const S& sys;
   const Velocity& V;
   double h;
-  VecN q_half, p_base;         // p1 = p_base + h omega(q_half)^T lambda, p_base = p0 + h F(q_half)
-  Mat<double, n, m> hWt;       // h omega(q_half)^T
-  Mat<double, ny, nl> W_t;     // empty
+  VecN q_half, p_base;      // p1 = p_base + h omega(q_half)^T lambda, p_base = p0 + h F(q_half)
+  Mat<double, n, m> hWt;    // h omega(q_half)^T
+  Mat<double, ny, nl> W_t;  // empty
 
   Mp06SeparableProblem(const S& s, const Velocity& vel, double hh, const VecN& q0, const VecN& p0)
       : sys(s), V(vel), h(hh) {

@@ -61,7 +61,7 @@ void Mp06Stepper<S, kSeparableForm>::start(const VecN& q0, const VecN& v0) {
 
 template <class S, bool kSeparableForm>
 StepSummary Mp06Stepper<S, kSeparableForm>::map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1,
-                                            VecM* lambda) const {
+                                                VecM* lambda) const {
   StepSummary s;
   if constexpr (kSeparable) {
     // One test per step picks V (SeparableVelocity in hamiltonian.hpp).

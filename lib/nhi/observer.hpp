@@ -79,9 +79,8 @@ class Recorder {
       o["lambda"] = rows(lambda_, m);
       o["discrete_constraint"] = rows(wd_, m);
     }
-    o["summary"] = {{"points", static_cast<long>(t_.size())},
-                    {"max_abs_energy_error", max_dE_},
-                    {"max_abs_constraint", max_c_}};
+    o["summary"] = {
+        {"points", static_cast<long>(t_.size())}, {"max_abs_energy_error", max_dE_}, {"max_abs_constraint", max_c_}};
   }
 
  private:

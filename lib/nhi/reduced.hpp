@@ -94,8 +94,7 @@ class ReducedDla {
   T reduced_lagrangian(const Vec<T, k>& ra, const Vec<T, k>& rb) const {
     Vec<T, m> zero;
     zero.setConstant(cst<T>(0.0));
-    return discrete_lagrangian<S, D, T>(sys_, disc_, h_, embed<T>(ra, zero),
-                                        embed<T>(rb, displacement<T>(ra, rb)));
+    return discrete_lagrangian<S, D, T>(sys_, disc_, h_, embed<T>(ra, zero), embed<T>(rb, displacement<T>(ra, rb)));
   }
 
   // D_slot L*_d(r_a, r_b) - F^{-/+}(r_a, r_b): slot 1 gives D1 L* - F^-, slot 2
@@ -108,7 +107,7 @@ class ReducedDla {
       raj[i] = slot == 1 ? J(ra[i], i) : J(ra[i]);
       rbj[i] = slot == 2 ? J(rb[i], i) : J(rb[i]);
     }
-    const J Ls = reduced_lagrangian<J>(raj, rbj);   // D_slot L*_d in Ls.v
+    const J Ls = reduced_lagrangian<J>(raj, rbj);    // D_slot L*_d in Ls.v
     const Vec<J, m> fj = displacement<J>(raj, rbj);  // f and df/dr_slot
     // dl/df: derivative of L_d in s_b at ((r_a, 0), (r_b, f)).
     using K = ceres::Jet<T, m>;
@@ -127,8 +126,7 @@ class ReducedDla {
     Vec<T, k> out;
     for (int i = 0; i < k; ++i) {
       T force = cst<T>(0.0);  // F^-: dl/df (df/dr_a - A(r_a)); F^+: dl/df (df/dr_b + A(r_b))
-      for (int a = 0; a < m; ++a)
-        force += Ld.v[a] * (slot == 1 ? fj[a].v[i] - A(a, i) : fj[a].v[i] + A(a, i));
+      for (int a = 0; a < m; ++a) force += Ld.v[a] * (slot == 1 ? fj[a].v[i] - A(a, i) : fj[a].v[i] + A(a, i));
       out[i] = forces ? Ls.v[i] - force : Ls.v[i];
     }
     return out;

@@ -36,9 +36,7 @@ class CvodeReference {
   static constexpr int n = S::n;
   using VecN = Vec<double, n>;
 
-  CvodeReference(const S& sys, double t0, const VecN& q0, const VecN& v0,
-                 ReferenceOptions opt = {})
-      : sys_(sys) {
+  CvodeReference(const S& sys, double t0, const VecN& q0, const VecN& v0, ReferenceOptions opt = {}) : sys_(sys) {
     if (SUNContext_Create(nullptr, &ctx_) != 0) throw std::runtime_error("SUNContext_Create failed");
     y_ = N_VNew_Serial(2 * n, ctx_);
     double* y = N_VGetArrayPointer(y_);
@@ -109,11 +107,9 @@ class CvodeReference {
     }
     return all_finite(a) ? 0 : 1;  // recoverable: CVODE retries with a smaller step
   }
-  static void on_error(int code, const char* module, const char* function, char* msg,
-                       void* user) {
+  static void on_error(int code, const char* module, const char* function, char* msg, void* user) {
     auto* self = static_cast<CvodeReference*>(user);
-    if (code < 0)
-      self->message_ = std::string(module) + "/" + function + ": " + msg;
+    if (code < 0) self->message_ = std::string(module) + "/" + function + ": " + msg;
   }
   void check(int flag, const char* what) {
     if (flag != 0) throw std::runtime_error(std::string(what) + " failed: " + message_);
@@ -172,8 +168,8 @@ class ReferenceStepper {
 
 // q(T) and v(T) of the reference solution from (q0, v0) at rtol = atol = tol.
 template <class S>
-void reference_solution(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T,
-                        double tol, Vec<double, S::n>* qT, Vec<double, S::n>* vT = nullptr) {
+void reference_solution(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T, double tol,
+                        Vec<double, S::n>* qT, Vec<double, S::n>* vT = nullptr) {
   ReferenceOptions opt;
   opt.rtol = opt.atol = tol;
   *qT = q0;

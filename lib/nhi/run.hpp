@@ -52,8 +52,8 @@ std::unique_ptr<AnyStepper<S::n, S::m>> make_stepper(const S& sys, const MethodS
 
 // run_spec with any callable observer (held by reference for the call).
 template <class S, class Observer>
-RunReport run_method(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0,
-                     const Vec<double, S::n>& v0, double h, long steps, Observer&& observe) {
+RunReport run_method(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+                     double h, long steps, Observer&& observe) {
   const SampleObserver<S::n, S::m> ref = [&observe](const Sample<S::n, S::m>& s) { return bool(observe(s)); };
   return run_spec<S>(sys, spec, q0, v0, h, steps, ref);
 }

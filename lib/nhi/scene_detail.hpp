@@ -5,8 +5,8 @@
 #pragma once
 
 #include <algorithm>
-#include <optional>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,8 +42,7 @@ inline double finite_number(const json& j, const std::string& key) {
 inline long integer(const json& j, const std::string& key, long lo, long hi) {
   if (j.is_number_float()) {
     const double x = j.get<double>();
-    if (!std::isfinite(x) || x != std::floor(x))
-      fail(key, "must be an integer, got " + show(j));
+    if (!std::isfinite(x) || x != std::floor(x)) fail(key, "must be an integer, got " + show(j));
     if (x < double(lo) || x > double(hi))
       fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + show(j));
     return static_cast<long>(x);
@@ -77,8 +76,7 @@ template <int N>
 Vec<double, N> vector_of(const json& j, const std::string& key) {
   if (!j.is_array()) fail(key, "must be an array of " + std::to_string(N) + " numbers, got " + show(j));
   if (j.size() != N)
-    fail(key, "must have " + std::to_string(N) + " entries for this system, got " +
-                  std::to_string(j.size()));
+    fail(key, "must have " + std::to_string(N) + " entries for this system, got " + std::to_string(j.size()));
   Vec<double, N> v;
   for (int i = 0; i < N; ++i) v[i] = finite_number(j[i], key + "[" + std::to_string(i) + "]");
   return v;

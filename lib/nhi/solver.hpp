@@ -339,7 +339,7 @@ class NewtonSolver {
     Mat<double, N, ny> Jy;
     LinearSolver solver(p_.Wt());
     bool fresh = true;  // r, Jy were just evaluated with derivatives at the iterate
-    VecX scale;  // of the rows, at the point of the last Jacobian
+    VecX scale;         // of the rows, at the point of the last Jacobian
     double rel = evaluate(y, lambda, &r, &Jy, &scale);
     ++s.evaluations;
     ++s.jacobians;
@@ -382,8 +382,8 @@ class NewtonSolver {
       }
       if (it == options_.max_iterations) {
         if (rel <= options_.tolerance) break;
-        s.message = "no convergence in " + std::to_string(it) + " iterations (relative residual " +
-                    std::to_string(rel) + ")";
+        s.message =
+            "no convergence in " + std::to_string(it) + " iterations (relative residual " + std::to_string(rel) + ")";
         s.failure = FailureKind::kSolve;
         return s;
       }

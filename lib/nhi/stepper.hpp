@@ -37,11 +37,16 @@ enum class FailureKind {
 
 inline const char* to_string(FailureKind k) {
   switch (k) {
-    case FailureKind::kNone: return "none";
-    case FailureKind::kSolve: return "solve";
-    case FailureKind::kNonFinite: return "non-finite";
-    case FailureKind::kInterrupted: return "interrupted";
-    case FailureKind::kObserver: return "observer";
+    case FailureKind::kNone:
+      return "none";
+    case FailureKind::kSolve:
+      return "solve";
+    case FailureKind::kNonFinite:
+      return "non-finite";
+    case FailureKind::kInterrupted:
+      return "interrupted";
+    case FailureKind::kObserver:
+      return "observer";
   }
   return "?";
 }
@@ -50,24 +55,24 @@ inline const char* to_string(FailureKind k) {
 struct StepSummary {
   SolveStatus status = SolveStatus::kFailed;
   FailureKind failure = FailureKind::kNone;  // when failed
-  int iterations = 0;            // Newton iterations (plus the fallback's, if it ran)
-  int evaluations = 0;           // residual(+Jacobian) evaluations
-  int jacobians = 0;             // of those, the ones with derivatives (Jets)
-  double relative_residual = 0;  // final max_i |r_i| / size of the terms of r_i
+  int iterations = 0;                        // Newton iterations (plus the fallback's, if it ran)
+  int evaluations = 0;                       // residual(+Jacobian) evaluations
+  int jacobians = 0;                         // of those, the ones with derivatives (Jets)
+  double relative_residual = 0;              // final max_i |r_i| / size of the terms of r_i
   bool used_fallback = false;
-  long rhs_evaluations = 0;      // explicit methods and the reference solution
-  long internal_steps = 0;       // adaptive methods
-  std::string message;           // why it failed, when it did
+  long rhs_evaluations = 0;  // explicit methods and the reference solution
+  long internal_steps = 0;   // adaptive methods
+  std::string message;       // why it failed, when it did
   bool ok() const { return status == SolveStatus::kConverged; }
 };
 
 // What a method declares about itself; tests and studies read these instead of
 // hard-coding expectations.
 struct MethodTraits {
-  int order = 0;                  // global order of q on smooth problems
-  int velocity_order = 0;         // ... of the reported v (0: the same as order)
-  bool symmetric = false;         // self-adjoint: a step of h then of -h returns to the start
-  bool symmetric_in_phase = true; // ... in (q, p) or (q, v); false: in q only (the DLA, see dla.hpp)
+  int order = 0;                           // global order of q on smooth problems
+  int velocity_order = 0;                  // ... of the reported v (0: the same as order)
+  bool symmetric = false;                  // self-adjoint: a step of h then of -h returns to the start
+  bool symmetric_in_phase = true;          // ... in (q, p) or (q, v); false: in q only (the DLA, see dla.hpp)
   bool holds_velocity_constraint = false;  // omega(q_k) v_k = 0 at grid points to round-off
   bool implicit = false;
   bool adaptive = false;          // h is only the output interval

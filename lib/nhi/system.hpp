@@ -86,8 +86,9 @@ struct has_exact_solution<S, std::void_t<decltype(&S::exact_solution)>> : std::t
 template <class S, class = void>
 struct has_section_states : std::false_type {};
 template <class S>
-struct has_section_states<S, std::void_t<decltype(std::declval<const S&>().section_states(1)),
-                                         decltype(S::section_coordinate)>> : std::true_type {};
+struct has_section_states<
+    S, std::void_t<decltype(std::declval<const S&>().section_states(1)), decltype(S::section_coordinate)>>
+    : std::true_type {};
 
 // One of the paper's own scenes (section 6), where its claims are asserted as stated.
 template <class S, class = void>
@@ -103,8 +104,8 @@ struct has_chaplygin_split<S, std::void_t<decltype(S::shape), decltype(S::group)
 template <class S, class = void>
 struct has_momentum_equation : std::false_type {};
 template <class S>
-struct has_momentum_equation<S, std::void_t<decltype(&S::nonholonomic_momentum),
-                                            decltype(&S::momentum_equation_rhs)>> : std::true_type {};
+struct has_momentum_equation<S, std::void_t<decltype(&S::nonholonomic_momentum), decltype(&S::momentum_equation_rhs)>>
+    : std::true_type {};
 
 template <class S, class = void>
 struct has_reduced_flow : std::false_type {};
@@ -118,8 +119,7 @@ template <class S, class T>
 struct has_partials<S, T,
                     std::void_t<decltype(std::declval<const S&>().template partials<T>(
                         std::declval<const Vec<T, S::n>&>(), std::declval<const Vec<T, S::n>&>(),
-                        std::declval<Vec<T, S::n>*>(), std::declval<Vec<T, S::n>*>()))>>
-    : std::true_type {};
+                        std::declval<Vec<T, S::n>*>(), std::declval<Vec<T, S::n>*>()))>> : std::true_type {};
 
 // Number of holonomic constraints g(q) = 0 the system declares (0 if none).
 template <class S, class = void>
@@ -129,8 +129,7 @@ struct holonomic_count<S, std::void_t<decltype(S::l)>> : std::integral_constant<
 
 // g(q) and its derivative Dg(q) (an l x n matrix) by one Jet.
 template <class S>
-inline Mat<double, holonomic_count<S>::value, S::n> holonomic_jacobian(const S& sys,
-                                                                        const Vec<double, S::n>& q) {
+inline Mat<double, holonomic_count<S>::value, S::n> holonomic_jacobian(const S& sys, const Vec<double, S::n>& q) {
   constexpr int n = S::n, l = holonomic_count<S>::value;
   Mat<double, l, n> G;
   if constexpr (l > 0) {
@@ -147,8 +146,8 @@ inline Mat<double, holonomic_count<S>::value, S::n> holonomic_jacobian(const S& 
 // dL/dq and dL/dqdot at (q, v) by autodiff of L: one forward-mode Jet over the
 // 2n inputs.  T may itself be a Jet (then this is a Jet of Jets: exact, slow).
 template <class S, class T>
-inline void autodiff_partials(const S& sys, const Vec<T, S::n>& q, const Vec<T, S::n>& v,
-                              Vec<T, S::n>* dLdq, Vec<T, S::n>* dLdv) {
+inline void autodiff_partials(const S& sys, const Vec<T, S::n>& q, const Vec<T, S::n>& v, Vec<T, S::n>* dLdq,
+                              Vec<T, S::n>* dLdv) {
   constexpr int n = S::n;
   using J = ceres::Jet<T, 2 * n>;
   Vec<J, n> qj, vj;
@@ -167,8 +166,8 @@ inline void autodiff_partials(const S& sys, const Vec<T, S::n>& q, const Vec<T, 
 // has them (the fast path; tests/test_systems.cpp checks them against
 // autodiff_partials to round-off, for double and for Jet), else autodiff.
 template <class S, class T>
-inline void lagrangian_partials(const S& sys, const Vec<T, S::n>& q, const Vec<T, S::n>& v,
-                                Vec<T, S::n>* dLdq, Vec<T, S::n>* dLdv) {
+inline void lagrangian_partials(const S& sys, const Vec<T, S::n>& q, const Vec<T, S::n>& v, Vec<T, S::n>* dLdq,
+                                Vec<T, S::n>* dLdv) {
   if constexpr (has_partials<S, T>::value) {
     sys.template partials<T>(q, v, dLdq, dLdv);
   } else {
@@ -178,8 +177,7 @@ inline void lagrangian_partials(const S& sys, const Vec<T, S::n>& q, const Vec<T
 
 // Momentum p = dL/dqdot.
 template <class S>
-inline Vec<double, S::n> momentum(const S& sys, const Vec<double, S::n>& q,
-                                  const Vec<double, S::n>& v) {
+inline Vec<double, S::n> momentum(const S& sys, const Vec<double, S::n>& q, const Vec<double, S::n>& v) {
   Vec<double, S::n> dq, dv;
   lagrangian_partials(sys, q, v, &dq, &dv);
   return dv;
@@ -195,8 +193,7 @@ inline double energy(const S& sys, const Vec<double, S::n>& q, const Vec<double,
 
 // Constraint values omega(q) v (zero along motions).
 template <class S>
-inline Vec<double, S::m> constraint_values(const S& sys, const Vec<double, S::n>& q,
-                                           const Vec<double, S::n>& v) {
+inline Vec<double, S::m> constraint_values(const S& sys, const Vec<double, S::n>& q, const Vec<double, S::n>& v) {
   return sys.template omega<double>(q) * v;
 }
 
@@ -206,8 +203,7 @@ inline Vec<double, S::m> constraint_values(const S& sys, const Vec<double, S::n>
 // with M = d2L/dqdot2, C = d2L/dqdot dq.  Returns a; *lambda gets the multiplier.
 // Used to check each scene's hand-written acceleration(), not on the hot path.
 template <class S>
-inline Vec<double, S::n> generic_acceleration(const S& sys, const Vec<double, S::n>& q,
-                                              const Vec<double, S::n>& v,
+inline Vec<double, S::n> generic_acceleration(const S& sys, const Vec<double, S::n>& q, const Vec<double, S::n>& v,
                                               Vec<double, S::m>* lambda = nullptr) {
   constexpr int n = S::n, m = S::m;
   using J = ceres::Jet<double, 2 * n>;

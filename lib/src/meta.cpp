@@ -23,8 +23,8 @@ json meta() {
           {"compiler", std::string("g++ ") + __VERSION__},
 #endif
           {"build_flags", NHI_BUILD_FLAGS},
-          {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) +
-                        "." + std::to_string(EIGEN_MINOR_VERSION)},
+          {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
+                        std::to_string(EIGEN_MINOR_VERSION)},
           {"ceres", CERES_VERSION_STRING},
           {"sundials", SUNDIALS_VERSION},
           {"nlohmann_json", std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." +

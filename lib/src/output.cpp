@@ -36,8 +36,10 @@ void AtomicFile::commit(const std::string& text) {
   bool ok = true;
   while (ok && done < text.size()) {
     const ssize_t k = ::write(fd_, text.data() + done, text.size() - done);
-    if (k < 0) ok = false;
-    else done += static_cast<size_t>(k);
+    if (k < 0)
+      ok = false;
+    else
+      done += static_cast<size_t>(k);
   }
   ok = ok && ::fsync(fd_) == 0;
   const int saved = errno;

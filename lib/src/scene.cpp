@@ -20,9 +20,8 @@ namespace {
 
 using namespace scene_detail;
 
-const std::vector<std::string> kKeys = {"system", "params", "q0",    "v0",        "method",
-                                        "discretization", "alpha", "h", "steps", "tolerance",
-                                        "output_every", "composition"};
+const std::vector<std::string> kKeys = {"system", "params", "q0",    "v0",        "method",       "discretization",
+                                        "alpha",  "h",      "steps", "tolerance", "output_every", "composition"};
 
 long peak_rss_kb() {
   rusage ru{};
@@ -61,8 +60,7 @@ json run_system(const S& sys, const json& sc) {
   json out;
   out["scene"] = sc;
   out["status"] = rep.ok ? "ok" : "failed";
-  if (!rep.ok) out["failure"] = {{"step", rep.failure_step}, {"time", rep.failure_step * h},
-                                 {"reason", rep.reason}};
+  if (!rep.ok) out["failure"] = {{"step", rep.failure_step}, {"time", rep.failure_step * h}, {"reason", rep.reason}};
   rec.write(&out);
   out["stats"] = {{"wall_seconds", wall},
                   {"cpu_seconds", cpu},
@@ -115,9 +113,8 @@ void refuse_if_too_large(const json& r, int n, int m, int first_integrals) {
     const long min_every = static_cast<long>(std::ceil(double(steps) * per_point / avail));
     std::ostringstream os;
     os.precision(3);
-    os << "the run would record " << points << " points, about " << bytes / 1e9
-       << " GB in memory, more than the " << avail / 1e9
-       << " GB available; record fewer points with output_every >= " << min_every;
+    os << "the run would record " << points << " points, about " << bytes / 1e9 << " GB in memory, more than the "
+       << avail / 1e9 << " GB available; record fewer points with output_every >= " << min_every;
     fail("output_every", os.str());
   }
 }
@@ -151,18 +148,19 @@ json catalog() {
   for (const StudyMethod& m : study_methods()) {
     if (m.external) continue;
     const MethodTraits t = method_traits(First{}, m.spec);
-    out["methods"].push_back({{"label", m.label()},
-                              {"method", m.spec.kind},
-                              {"discretization", method_flags(m.spec.kind).uses_discretization
-                                                     ? json(m.spec.discretization) : json(nullptr)},
-                              {"alpha", method_flags(m.spec.kind).uses_discretization ? json(m.spec.alpha) : json(nullptr)},
-                              {"composition", m.spec.composition},
-                              {"order", t.order},
-                              {"symmetric", t.symmetric},
-                              {"implicit", t.implicit},
-                              {"adaptive", t.adaptive},
-                              {"composable", m.spec.composition == "none" && method_is_symmetric(m.spec)},
-                              {"group", m.group}});
+    out["methods"].push_back(
+        {{"label", m.label()},
+         {"method", m.spec.kind},
+         {"discretization",
+          method_flags(m.spec.kind).uses_discretization ? json(m.spec.discretization) : json(nullptr)},
+         {"alpha", method_flags(m.spec.kind).uses_discretization ? json(m.spec.alpha) : json(nullptr)},
+         {"composition", m.spec.composition},
+         {"order", t.order},
+         {"symmetric", t.symmetric},
+         {"implicit", t.implicit},
+         {"adaptive", t.adaptive},
+         {"composable", m.spec.composition == "none" && method_is_symmetric(m.spec)},
+         {"group", m.group}});
   }
   out["compositions"] = json::array();
   for (const Composition& c : compositions())
@@ -203,8 +201,7 @@ json parse_scene_text(const std::string& text, const std::string& origin) {
 
 void apply_override(json* scene, const std::string& assignment) {
   const auto eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0)
-    throw SceneError("--set expects key=value, got '" + assignment + "'");
+  if (eq == std::string::npos || eq == 0) throw SceneError("--set expects key=value, got '" + assignment + "'");
   const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
   json value;
   try {
@@ -231,8 +228,7 @@ void apply_override(json* scene, const std::string& assignment) {
 json validate_scene(const json& scene) {
   if (!scene.is_object()) throw SceneError("scene must be a JSON object, got " + show(scene));
   for (const auto& [key, value] : scene.items())
-    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end())
-      fail(key, "unknown key");
+    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end()) fail(key, "unknown key");
   for (const char* key : {"system", "q0", "v0", "method", "h", "steps"})
     if (!scene.contains(key)) fail(key, "missing (required)");
 
@@ -247,9 +243,8 @@ json validate_scene(const json& scene) {
   const double alpha = scene.contains("alpha") ? finite_number(scene["alpha"], "alpha") : 0.5;
   if (!(alpha >= 0.0 && alpha <= 1.0)) fail("alpha", "must be in [0, 1], got " + show(scene["alpha"]));
   r["alpha"] = alpha;
-  r["composition"] = scene.contains("composition")
-                         ? one_of(scene["composition"], "composition", composition_names())
-                         : "none";
+  r["composition"] =
+      scene.contains("composition") ? one_of(scene["composition"], "composition", composition_names()) : "none";
   if (r["composition"] != "none") {
     MethodSpec spec;
     spec.kind = r["method"];
@@ -258,7 +253,8 @@ json validate_scene(const json& scene) {
     if (!method_is_symmetric(spec))
       fail("composition", "\"" + r["composition"].get<std::string>() +
                               "\" composes only symmetric methods (mp06, discrete_gradient, dla with alpha = 0.5 "
-                              "or discretization \"symmetric\"), not " + spec.label());
+                              "or discretization \"symmetric\"), not " +
+                              spec.label());
   }
   const double h = finite_number(scene["h"], "h");
   if (!(h > 0)) fail("h", "must be > 0, got " + show(scene["h"]));
@@ -267,11 +263,9 @@ json validate_scene(const json& scene) {
   const double tol = scene.contains("tolerance") ? finite_number(scene["tolerance"], "tolerance") : 1e-12;
   if (!(tol > 0 && tol < 1)) fail("tolerance", "must be in (0, 1), got " + show(scene["tolerance"]));
   r["tolerance"] = tol;
-  r["output_every"] = scene.contains("output_every")
-                          ? integer(scene["output_every"], "output_every", 1, 10'000'000'000L)
-                          : 1L;
-  if (!std::isfinite(h * double(r["steps"].get<long>())))
-    fail("h", "h * steps is not finite");
+  r["output_every"] =
+      scene.contains("output_every") ? integer(scene["output_every"], "output_every", 1, 10'000'000'000L) : 1L;
+  if (!std::isfinite(h * double(r["steps"].get<long>()))) fail("h", "h * steps is not finite");
 
   json params;
   with_system(scene, &params, [&](const auto& sys) {
@@ -288,8 +282,7 @@ json validate_scene(const json& scene) {
       const double scale = (W.row(a).cwiseAbs() * v0.cwiseAbs()).sum();
       if (!(std::abs(c) <= 1e-9 * std::max(scale, 1e-300) || c == 0.0)) {
         std::ostringstream os;
-        os << "violates constraint " << a << ": omega(q0) v0 = " << c
-           << " (allowed: 1e-9 relative to " << scale << ")";
+        os << "violates constraint " << a << ": omega(q0) v0 = " << c << " (allowed: 1e-9 relative to " << scale << ")";
         fail("v0", os.str());
       }
     }

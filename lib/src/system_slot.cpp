@@ -74,7 +74,7 @@ template RunReport run_spec<SlotSystem>(const SlotSystem&, const MethodSpec&, co
                                         const SampleObserver<SlotSystem::n, SlotSystem::m>&);
 template MethodTraits method_traits<SlotSystem>(const SlotSystem&, const MethodSpec&);
 template std::unique_ptr<AnyStepper<SlotSystem::n, SlotSystem::m>> make_stepper<SlotSystem>(const SlotSystem&,
-                                                                                         const MethodSpec&);
+                                                                                            const MethodSpec&);
 #endif
 
 }  // namespace nhi

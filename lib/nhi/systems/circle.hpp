@@ -37,9 +37,13 @@ struct CircleHolonomic {
   static constexpr const char* name = "particle on a circle (g)";
   CircleParticle c;
   template <class T>
-  T lagrangian(const Vec<T, 2>& q, const Vec<T, 2>& v) const { return c.lagrangian<T>(q, v); }
+  T lagrangian(const Vec<T, 2>& q, const Vec<T, 2>& v) const {
+    return c.lagrangian<T>(q, v);
+  }
   template <class T>
-  Mat<T, 0, 2> omega(const Vec<T, 2>&) const { return Mat<T, 0, 2>(); }
+  Mat<T, 0, 2> omega(const Vec<T, 2>&) const {
+    return Mat<T, 0, 2>();
+  }
   template <class T>
   Vec<T, 1> g(const Vec<T, 2>& q) const {
     return Vec<T, 1>(cst<T>(0.5) * (q[0] * q[0] + q[1] * q[1] - cst<T>(1.0)));

@@ -53,7 +53,8 @@ struct Particle {
 
   template <class T>
   T lagrangian(const Vec<T, 3>& q, const Vec<T, 3>& v) const {
-    return cst<T>(0.5) * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) - (cst<T>(kx) * q[0] * q[0] + cst<T>(ky) * q[1] * q[1]);
+    return cst<T>(0.5) * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) -
+           (cst<T>(kx) * q[0] * q[0] + cst<T>(ky) * q[1] * q[1]);
   }
 
   // Hand-written dL/dq, dL/dqdot (fast path; checked against autodiff of L).
@@ -88,11 +89,8 @@ struct Particle {
   // nonholonomic momentum J_k = <p_k, xi(q_k)_Q> = p_x + y p_z, and eq. (24) reads
   // J_{k+1} - J_k = <p_{k+1}, (xi(q_{k+1}) - xi(q_k))_Q> = p_{z,k+1} (y_{k+1} - y_k).
   // Continuous (eq. 23): d/dt (xd + y zd) = zd yd.
-  static double nonholonomic_momentum(const Vec<double, 3>& q, const Vec<double, 3>& p) {
-    return p[0] + q[1] * p[2];
-  }
-  static double momentum_equation_rhs(const Vec<double, 3>& q0, const Vec<double, 3>& q1,
-                                      const Vec<double, 3>& p1) {
+  static double nonholonomic_momentum(const Vec<double, 3>& q, const Vec<double, 3>& p) { return p[0] + q[1] * p[2]; }
+  static double momentum_equation_rhs(const Vec<double, 3>& q0, const Vec<double, 3>& q1, const Vec<double, 3>& p1) {
     return p1[2] * (q1[1] - q0[1]);
   }
 

@@ -20,7 +20,8 @@
 namespace nhi {
 
 // The registration line: X(Type) for each scene, in this order.
-#define NHI_REGISTERED_SYSTEMS(X) X(Particle) X(Robot) X(ContactOscillator) X(ContactOscillatorNR) X(ChaoticOscillator) X(Sleigh)
+#define NHI_REGISTERED_SYSTEMS(X) \
+  X(Particle) X(Robot) X(ContactOscillator) X(ContactOscillatorNR) X(ChaoticOscillator) X(Sleigh)
 
 #define NHI_COMMA_THEN_(S) , S
 using Systems = typename Rest<TypeList<void NHI_REGISTERED_SYSTEMS(NHI_COMMA_THEN_)>>::type;

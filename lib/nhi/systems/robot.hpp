@@ -107,8 +107,7 @@ struct Robot {
   // J_k = p_theta, and xi(q_{k+1}) - xi(q_k) is the translation (dy, -dx):
   // p_{theta,k+1} - p_{theta,k} = p_{x,k+1} (y_{k+1} - y_k) - p_{y,k+1} (x_{k+1} - x_k).
   static double nonholonomic_momentum(const Vec<double, 4>&, const Vec<double, 4>& p) { return p[2]; }
-  static double momentum_equation_rhs(const Vec<double, 4>& q0, const Vec<double, 4>& q1,
-                                      const Vec<double, 4>& p1) {
+  static double momentum_equation_rhs(const Vec<double, 4>& q0, const Vec<double, 4>& q1, const Vec<double, 4>& p1) {
     return p1[0] * (q1[1] - q0[1]) - p1[1] * (q1[0] - q0[0]);
   }
 
@@ -124,13 +123,12 @@ struct Robot {
   // steps per unit time on  psidd = -V0 cos(psi) / (3 Iw + m R^2),
   // xd = R cos(theta(t)) psid,  yd = R sin(theta(t)) psid.  A formulation that
   // shares no code with the index-reduced ODE, used as a second benchmark.
-  void reduced_flow(const Vec<double, 4>& q0, const Vec<double, 4>& v0, double t,
-                    long substeps_per_unit, Vec<double, 4>* q, Vec<double, 4>* v) const {
+  void reduced_flow(const Vec<double, 4>& q0, const Vec<double, 4>& v0, double t, long substeps_per_unit,
+                    Vec<double, 4>* q, Vec<double, 4>* v) const {
     const double k = V0 / (3.0 * Iw + mass * R * R);
     auto rhs = [&](double tt, const Eigen::Vector4d& y) {
       const double th = q0[2] + v0[2] * tt;
-      return Eigen::Vector4d(y[1], -k * std::cos(y[0]), R * std::cos(th) * y[1],
-                             R * std::sin(th) * y[1]);
+      return Eigen::Vector4d(y[1], -k * std::cos(y[0]), R * std::cos(th) * y[1], R * std::sin(th) * y[1]);
     };
     Eigen::Vector4d y(q0[3], v0[3], q0[0], q0[1]);
     const long steps = std::max(1L, static_cast<long>(std::ceil(std::abs(t) * substeps_per_unit)));

@@ -28,8 +28,7 @@ struct RobotExtrinsic {
 
   template <class T>
   T lagrangian(const Vec<T, 6>& q, const Vec<T, 6>& v) const {
-    return cst<T>(0.5 * r.mass) * (v[0] * v[0] + v[1] * v[1]) +
-           cst<T>(0.5 * r.I) * (v[2] * v[2] + v[3] * v[3]) +
+    return cst<T>(0.5 * r.mass) * (v[0] * v[0] + v[1] * v[1]) + cst<T>(0.5 * r.I) * (v[2] * v[2] + v[3] * v[3]) +
            cst<T>(1.5 * r.Iw) * (v[4] * v[4] + v[5] * v[5]) - cst<T>(r.V0) * q[5];
   }
 
@@ -73,11 +72,8 @@ struct RobotExtrinsic {
   }
   // Back to the angle chart; `near` picks the branch of each angle (continuity).
   static Vec<double, 4> chart(const Vec<double, 6>& v, const Vec<double, 4>& near) {
-    auto lift = [](double a, double ref) {
-      return a + 2 * M_PI * std::round((ref - a) / (2 * M_PI));
-    };
-    return Vec<double, 4>(v[0], v[1], lift(std::atan2(v[3], v[2]), near[2]),
-                          lift(std::atan2(v[5], v[4]), near[3]));
+    auto lift = [](double a, double ref) { return a + 2 * M_PI * std::round((ref - a) / (2 * M_PI)); };
+    return Vec<double, 4>(v[0], v[1], lift(std::atan2(v[3], v[2]), near[2]), lift(std::atan2(v[5], v[4]), near[3]));
   }
 };
 

@@ -69,8 +69,7 @@ struct Sleigh {
 
   template <class T>
   T lagrangian(const Vec<T, 3>& q, const Vec<T, 3>& v) const {
-    return cst<T>(0.5 * mass) * (v[0] * v[0] + v[1] * v[1]) + cst<T>(0.5 * I) * v[2] * v[2] -
-           cst<T>(mass * g) * q[1];
+    return cst<T>(0.5 * mass) * (v[0] * v[0] + v[1] * v[1]) + cst<T>(0.5 * I) * v[2] * v[2] - cst<T>(mass * g) * q[1];
   }
 
   template <class T>
