@@ -36,9 +36,10 @@ NATIVE ?= OFF
 # generator here); an existing tree keeps the generator it was made with.
 GENERATOR = $(if $(wildcard $(BUILD)/CMakeCache.txt),,-G Ninja)
 CONFIGURE = cmake -S . -B $(BUILD) $(GENERATOR) -DCMAKE_BUILD_TYPE=Release -DNHI_NATIVE=$(NATIVE)
+# The runner, the studies and the benchmark (the tests build in $(TEST_BUILD), below).
 build: deps
 	$(CONFIGURE)
-	cmake --build $(BUILD) -j$(JOBS)
+	cmake --build $(BUILD) -j$(JOBS) --target nhi_experiments
 
 # A figure or study target asked for directly builds the binaries if they are missing.
 $(BUILD)/bin/%:

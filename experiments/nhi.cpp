@@ -146,7 +146,7 @@ int main(int argc, char** argv) {
     return error("interrupted; no result written", 130);
   }
 
-  const std::string text = result.dump() + "\n";
+  const std::string text = nhi::json_lines(result);
   if (!out) {
     std::cout << text;
   } else {

@@ -105,7 +105,7 @@ inline std::vector<nhi::StudyMethod> methods(const std::function<bool(const nhi:
   return out;
 }
 // Library methods with a fixed step (everything but the reference and the external ones).
-inline bool fixed_step(const nhi::StudyMethod& m) { return !m.external && m.spec.kind != "benchmark"; }
+inline bool fixed_step(const nhi::StudyMethod& m) { return m.fixed_step(); }
 
 inline double thread_cpu_seconds() {
   timespec ts{};
@@ -166,22 +166,9 @@ inline json report_json(const nhi::RunReport& rep, double h) {
 
 // ---- Cells: the unit of work distributed over threads and ranks ------------
 
-// The estimated cost of a step of a method, in RK4 steps of the same scene:
-// the per-stage costs of results/step_costs.json on the paper's scenes, rounded,
-// times the composition's stages.  Only the balance of the ranks depends on it.
-inline double step_weight(const nhi::MethodSpec& spec) {
-  double w = 1.0;
-  if (spec.kind == "dla")
-    w = 6.0;
-  else if (spec.kind == "mp06")
-    w = 1.5;
-  else if (spec.kind == "discrete_gradient")
-    w = 15.0;
-  else if (spec.kind == "benchmark")
-    w = 30.0;  // per output interval h
-  const int stages = spec.kind == "benchmark" ? 1 : static_cast<int>(nhi::composition(spec.composition).gamma.size());
-  return w * stages;
-}
+// The estimated cost of a step of a method, in RK4 steps of the same scene
+// (the method's step_cost, methods.hpp).  Only the balance of the ranks depends on it.
+inline double step_weight(const nhi::MethodSpec& spec) { return nhi::method_step_cost(spec); }
 
 // A study's phase of independent cells.  run(i) computes cell i and returns its
 // JSON; it may throw (the study then fails, naming the cell).  cost(i) is the
@@ -379,7 +366,7 @@ inline int finish(const Options& o, json result) {
     result["meta"] = nhi::meta();
     try {
       nhi::AtomicFile f(o.out);
-      f.commit(result.dump() + "\n");
+      f.commit(nhi::json_lines(result));
     } catch (const std::exception& e) {
       std::cerr << "study: error: " << e.what() << "\n";
       code = 1;

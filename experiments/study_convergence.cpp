@@ -24,7 +24,6 @@ constexpr size_t kFitPoints = 4;  // the finest h with error above the floor
 struct Variant {
   std::string label, family;  // family: alpha, symmetric, rk4, isolation
   double alpha = 0.5;
-  int style = 0;                           // nhi::method_style (0: not a study method)
   std::function<json(double h)> error_at;  // returns {"error", "cpu_seconds", "status"}
   double weight = 1.0;                     // study::step_weight: estimated cost of a step
 };
@@ -51,7 +50,7 @@ std::vector<Variant> variants(const S& sys, const Vec<double, S::n>& q0, const V
   for (const nhi::StudyMethod& m : study::methods(study::fixed_step)) {
     const nhi::MethodSpec spec = m.spec;
     const std::string family = spec.kind == "dla" ? spec.discretization : spec.kind;
-    out.push_back({m.label(), family, spec.alpha, m.style(),
+    out.push_back({m.label(), family, spec.alpha,
                    [=, &sys](double h) {
                      return measure<S>(
                          qref, [&](auto&& obs) { return nhi::run_method(sys, spec, q0, v0, h, steps(h), obs); });
@@ -73,7 +72,7 @@ std::vector<Variant> variants(const S& sys, const Vec<double, S::n>& q0, const V
       char label[96];
       std::snprintf(label, sizeof label, "%s (a=%g)", iso.name, a);
       out.push_back(
-          {label, "isolation", a, 0,
+          {label, "isolation", a,
            [=, &sys](double h) {
              Vec<double, S::n> Lq, Lv;
              nhi::autodiff_partials(sys, q0, v0, &Lq, &Lv);
@@ -138,13 +137,9 @@ int main(int argc, char** argv) {
           rs.push_back(runs[v * hs.size() + j]);
           errs.push_back(runs[v * hs.size() + j].value("error", std::nan("")));
         }
-        json m = {{"label", vs[v].label},
-                  {"family", vs[v].family},
-                  {"alpha", vs[v].alpha},
-                  {"style", vs[v].style},
-                  {"h", hs},
-                  {"error", errs},
-                  {"runs", rs}};
+        json m = {{"label", vs[v].label}, {"family", vs[v].family},
+                  {"alpha", vs[v].alpha}, {"h", hs},
+                  {"error", errs},        {"runs", rs}};
         m.update(fit(hs, rs));
         methods.push_back(m);
       }

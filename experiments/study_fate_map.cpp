@@ -200,7 +200,6 @@ int main(int argc, char** argv) {
           if (!half_broken) largest_half = g.hs[j];
         }
         ms.push_back({{"label", g.methods[m].label()},
-                      {"style", g.methods[m].style()},
                       {"fates", fates},
                       {"stable", stable},
                       {"energy", energy},

@@ -216,7 +216,6 @@ int main(int argc, char** argv) {
       j["label"] = m.label();
       j["steps"] = steps;
       j["T"] = h * double(steps);
-      j["style"] = m.style();
       j["group"] = m.group;
       j.update(study::report_json(rep, h));
       if (rep.failure == nhi::FailureKind::kObserver) j["failure"]["reason"] = "non-finite energy or constraint";

@@ -227,8 +227,7 @@ int main(int argc, char** argv) {
           }
           for (size_t i = 0; i < names.size(); ++i)
             summary["max_abs_" + std::string(names[i]) + "_error"] = worst_dI[i];
-          ms.push_back(
-              {{"label", methods[m].label()}, {"style", methods[m].style()}, {"summary", summary}, {"runs", runs}});
+          ms.push_back({{"label", methods[m].label()}, {"summary", summary}, {"runs", runs}});
         }
         json init = json::array();
         for (const auto& st : states)

@@ -119,7 +119,6 @@ int main(int argc, char** argv) {
           if (!r["survived"]) dead = true;
         }
         ms.push_back({{"label", methods[m].label()},
-                      {"style", methods[m].style()},
                       {"runs", rs},
                       {"largest_stable_h", largest > 0 ? json(largest) : json(nullptr)},
                       {"largest_surviving_h", survivor > 0 ? json(survivor) : json(nullptr)},

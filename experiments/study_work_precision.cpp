@@ -257,7 +257,6 @@ int main(int argc, char** argv) {
       cells.run = [&](size_t i) {
         const Config& c = configs[i];
         json row = {{"label", c.method.label()},
-                    {"style", c.method.style()},
                     {"adaptive", c.method.external || c.method.spec.kind == "benchmark"},
                     {"param", c.param}};
         Vec<double, n> qT = q0;

@@ -8,8 +8,11 @@
 // method adds it here.
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <optional>
+#include <set>
 
 #include "scenes.hpp"
 
@@ -22,7 +25,7 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 std::vector<StudyMethod> fixed_step_methods() {
   std::vector<StudyMethod> out;
   for (const auto& m : study_methods())
-    if (!m.external && m.spec.kind != "benchmark") out.push_back(m);
+    if (m.fixed_step()) out.push_back(m);
   return out;
 }
 
@@ -434,6 +437,24 @@ TYPED_TEST(MethodContract, PinnedNumbers) {
     for (int i = 0; i < S::n; ++i)
       EXPECT_NEAR(f.q[i], it->second[i], 1e-12 * (1 + std::abs(it->second[i]))) << key << " q[" << i << "]";
   }
+}
+
+// Every study method has a label of its own, a style of its own in
+// plots/style.gp (keyed by label, so a new method moves no other method's
+// colour) and a positive step cost for the studies' scheduling.
+TEST(MethodList, EveryStudyMethodHasItsOwnLabelStyleAndCost) {
+  std::ifstream in(NHI_SOURCE_DIR "/plots/style.gp");
+  ASSERT_TRUE(in) << "cannot read plots/style.gp";
+  const std::string style((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::set<std::string> seen;
+  for (const StudyMethod& m : study_methods()) {
+    EXPECT_TRUE(seen.insert(m.label()).second) << "two study methods are labelled " << m.label();
+    EXPECT_NE(style.find("label eq \"" + m.label() + "\" ?"), std::string::npos)
+        << "plots/style.gp has no style for " << m.label() << " (add a line to method_ls)";
+    EXPECT_GT(method_step_cost(m.spec), 0.0) << m.label();
+  }
+  // A composed method costs its stages.
+  EXPECT_EQ(method_step_cost(spec_of("mp06", "triple_jump")), 3 * method_step_cost(spec_of("mp06")));
 }
 
 }  // namespace

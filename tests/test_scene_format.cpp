@@ -2,6 +2,7 @@
 // SceneError naming the key; a good scene resolves with its defaults.
 #include <gtest/gtest.h>
 
+#include "nhi/output.hpp"
 #include "nhi/scene.hpp"
 
 namespace nhi {
@@ -262,6 +263,27 @@ TEST(Scene, RunRecordsEveryPointAndTheSummary) {
   EXPECT_EQ(full["t"].size(), 8u);
   EXPECT_EQ(full["summary"]["max_abs_energy_error"], r["summary"]["max_abs_energy_error"]);
   EXPECT_EQ(full["summary"]["max_abs_constraint"], r["summary"]["max_abs_constraint"]);
+}
+
+// A result's text (json_lines): the same JSON, a line per member and per
+// element of a long array, rows of numbers on one line, numbers as dump() writes them.
+TEST(ResultText, IsTheSameJsonWithOneRowALine) {
+  json r = {{"status", "ok"}, {"x", 0.1}, {"empty", json::array()}, {"none", json::object()}};
+  for (int i = 0; i < 40; ++i) {
+    r["t"].push_back(0.1 * i);
+    r["q"].push_back({1.0 / (i + 1), -2.5e-300, i});
+  }
+  r["meta"] = {{"git_revision", "abc"}, {"nested", {{"k", {1, 2}}}}};
+  const std::string text = json_lines(r);
+  EXPECT_EQ(json::parse(text), r);
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n');
+  size_t lines = 0;
+  for (char c : text) lines += c == '\n';
+  EXPECT_GT(lines, 80u);  // 40 times, 40 rows of q, and the members
+  EXPECT_NE(text.find("\n  " + r["q"][3].dump() + ",\n"), std::string::npos) << text.substr(0, 400);
+  EXPECT_NE(text.find("\n  " + r["t"][7].dump() + ",\n"), std::string::npos);
+  EXPECT_NE(text.find("\"k\": [1,2]"), std::string::npos);
 }
 
 }  // namespace

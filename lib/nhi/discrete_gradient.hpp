@@ -65,8 +65,11 @@ struct DiscreteGradientProblem {
   // row that contains it (when the velocities in a constraint row vanish
   // together, it is all that is left of that row's size).  *c_out (may be
   // null) gets Gonzalez's coefficient c (0 when dz = 0).
+  // Flattened: with T a Jet of the 2n + m unknowns, g++ otherwise stops
+  // inlining at its function-growth limit and leaves the Jets' vector updates
+  // as calls (on contact_oscillator_nr, whose H is not separable).
   template <class T>
-  void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp, VecN* sq = nullptr,
+  [[gnu::flatten]] void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp, VecN* sq = nullptr,
                          VecN* sp = nullptr, T* c_out = nullptr) const {
     const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1), pb = cst<T>(0.5) * (p0.template cast<T>() + p1);
     const Vec<T, n> gq = -force(sys, qb, pb), gp = velocity(sys, qb, pb);
@@ -271,6 +274,8 @@ struct DiscreteGradientMethod {
   static constexpr bool uses_discretization = false;
   static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
   static constexpr bool reports_p = true;
+  static constexpr double step_cost = 15.0;
+  static std::string label(const MethodSpec&) { return name; }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
     SolverOptions opt;

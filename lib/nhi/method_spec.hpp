@@ -3,7 +3,6 @@
 // each method's header can declare its own table entry (see methods.hpp).
 #pragma once
 
-#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,18 +16,12 @@ struct MethodSpec {
   double tolerance = 1e-12;          // implicit methods: relative residual; the reference: CVODE rtol = atol
   std::string composition = "none";  // symmetric methods: composition.hpp
 
-  // The one label scheme: "dla a=0.5", "dla-sym a=0", "rk4", "reference",
-  // "mp06", "mp06+triple_jump", "discrete_gradient+order6", "dla a=0.5+triple_jump".
-  std::string label() const {
-    char buf[96];
-    if (kind == "dla")
-      std::snprintf(buf, sizeof buf, "%s a=%g", discretization == "alpha" ? "dla" : "dla-sym", alpha);
-    else if (kind == "benchmark")
-      std::snprintf(buf, sizeof buf, "reference");
-    else
-      std::snprintf(buf, sizeof buf, "%s", kind.c_str());
-    return composition == "none" ? std::string(buf) : std::string(buf) + "+" + composition;
-  }
+  // The one label scheme, the key of a method's style in plots/style.gp:
+  // the method's own label (its struct's label(spec): "dla a=0.5", "dla-sym a=0",
+  // "rk4", "reference", "mp06", ...), then "+composition" when composed, e.g.
+  // "mp06+triple_jump".  A kind no method has is labelled by its name ("rkf78").
+  // Defined in lib/src/methods.cpp, where the method list is.
+  std::string label() const;
 };
 
 // A method's entry in the studies: "main" methods are in every study;

@@ -9,6 +9,10 @@
 //   static constexpr bool reports_p;            // its samples carry p and lambda
 //   template <class S, class F> static auto with_stepper(const S&, const MethodSpec&, F&& f);
 //   static std::vector<StudyEntry> study_entries();   // what the studies run of it
+//   static std::string label(const MethodSpec&);      // its label before "+composition",
+//                                                     // the key of its style in plots/style.gp
+//   static constexpr double step_cost;                // a step (one stage) in RK4 steps of the
+//                                                     // same scene, for scheduling the studies' cells
 // which builds the stepper the spec describes and returns f(stepper).  Adding a
 // method is one header (its stepper and this small struct, e.g. mp06.hpp) and
 // one entry in `Methods` (with its #include); it then runs through `nhi run`,
@@ -16,6 +20,7 @@
 // tests (tests/test_methods.cpp).
 #pragma once
 
+#include <cstdio>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -38,6 +43,12 @@ struct DlaMethod {
   static constexpr const char* name = "dla";
   static constexpr bool uses_discretization = true;
   static constexpr bool reports_p = true;
+  static constexpr double step_cost = 6.0;
+  static std::string label(const MethodSpec& spec) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s a=%g", spec.discretization == "alpha" ? "dla" : "dla-sym", spec.alpha);
+    return buf;
+  }
   // Self-adjoint discretizations (alpha = 1/2, the symmetric family) compose:
   // dla_composition.hpp, README "Methods".
   static bool symmetric(const MethodSpec& spec) {
@@ -91,6 +102,8 @@ struct Rk4Method {
   static constexpr const char* name = "rk4";
   static constexpr bool uses_discretization = false;
   static constexpr bool reports_p = false;
+  static constexpr double step_cost = 1.0;
+  static std::string label(const MethodSpec&) { return name; }
   static bool symmetric(const MethodSpec&) { return false; }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec&, F&& f) {
@@ -105,6 +118,8 @@ struct ReferenceMethod {
   static constexpr const char* name = "benchmark";
   static constexpr bool uses_discretization = false;
   static constexpr bool reports_p = false;
+  static constexpr double step_cost = 30.0;  // per output interval h
+  static std::string label(const MethodSpec&) { return "reference"; }
   static bool symmetric(const MethodSpec&) { return false; }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
@@ -151,6 +166,18 @@ inline MethodFlags method_flags(const std::string& kind) {
   return fl;
 }
 
+// The estimated cost of a step of the method spec names, in RK4 steps of the
+// same scene: its step_cost times the composition's stages.  Only the balance
+// of the studies' threads and ranks depends on it.
+// A kind no method has (the studies' external methods) counts as one RK4 step.
+inline double method_step_cost(const MethodSpec& spec) {
+  double w = 1.0;
+  for_each_type(Methods{}, [&](auto tag) {
+    if (spec.kind == decltype(tag)::type::name) w = decltype(tag)::type::step_cost;
+  });
+  return spec.kind == ReferenceMethod::name ? w : w * static_cast<double>(composition(spec.composition).gamma.size());
+}
+
 // Is the method the spec names self-adjoint (and so composable)?
 inline bool method_is_symmetric(const MethodSpec& spec) {
   bool sym = false;
@@ -173,20 +200,21 @@ auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
 
 // The methods the studies run, in a fixed order: every method's "main"
 // study_entries() in the order of `Methods`, then every "variant", then the
-// external ones.  The position in this list is the method's style (colour and
-// point type) in plots/style.gp, in every figure.  "main" methods are in every
+// external ones.  A method's style (colour and point type) in every figure is
+// keyed by its label in plots/style.gp.  "main" methods are in every
 // study; "variant"s (the paper's other alphas, the costlier compositions) in
 // those that sweep them.  Entries with external = true are not library methods
 // (Boost.Odeint's adaptive pairs, run by the work-precision study only; their
 // spec names a kind no method has, so it cannot be run by mistake); they are
-// listed here so that their label and style are fixed in the same place.
+// listed here so that their labels are fixed in the same place.
 struct StudyMethod {
   MethodSpec spec;
   std::string group;  // "main" or "variant"
   bool external = false;
   std::string external_label;
   std::string label() const { return external ? external_label : spec.label(); }
-  int style() const;
+  // A library method with a fixed step (not the adaptive reference, not external).
+  bool fixed_step() const { return !external && spec.kind != ReferenceMethod::name; }
 };
 
 inline const std::vector<StudyMethod>& study_methods() {
@@ -203,14 +231,5 @@ inline const std::vector<StudyMethod>& study_methods() {
   }();
   return list;
 }
-
-// 1-based style of a label (0 if it is not in study_methods()).
-inline int method_style(const std::string& label) {
-  const auto& list = study_methods();
-  for (size_t i = 0; i < list.size(); ++i)
-    if (list[i].label() == label) return static_cast<int>(i) + 1;
-  return 0;
-}
-inline int StudyMethod::style() const { return method_style(label()); }
 
 }  // namespace nhi

@@ -435,6 +435,8 @@ struct Mp06Method {
   static constexpr bool uses_discretization = false;
   static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
   static constexpr bool reports_p = true;
+  static constexpr double step_cost = 1.5;
+  static std::string label(const MethodSpec&) { return name; }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
     SolverOptions opt;

@@ -3,9 +3,17 @@
 // rename.  Destroying an uncommitted AtomicFile removes the temporary.
 #pragma once
 
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 
 namespace nhi {
+
+// A result's text: the JSON with each object member, and each element of an
+// array that is not a short row of numbers, on a line of its own (rows of at
+// most 16 scalars stay on one line), so that a rerun that moves a few numbers
+// changes a few lines.  The numbers are written as nlohmann::json::dump()
+// writes them; the text ends with a newline.
+std::string json_lines(const nlohmann::json& j);
 
 class AtomicFile {
  public:

@@ -7,9 +7,60 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 namespace nhi {
+
+namespace {
+
+bool is_short_row(const nlohmann::json& j) {
+  if (j.size() > 16) return false;
+  for (const auto& e : j)
+    if (e.is_structured()) return false;
+  return true;
+}
+
+void append_lines(std::string& out, const nlohmann::json& j, size_t depth) {
+  if (j.is_object() && !j.empty()) {
+    out += "{\n";
+    bool first = true;
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (!first) out += ",\n";
+      first = false;
+      out.append(depth + 1, ' ');
+      out += nlohmann::json(it.key()).dump();
+      out += ": ";
+      append_lines(out, it.value(), depth + 1);
+    }
+    out += '\n';
+    out.append(depth, ' ');
+    out += '}';
+  } else if (j.is_array() && !is_short_row(j)) {
+    out += "[\n";
+    bool first = true;
+    for (const auto& e : j) {
+      if (!first) out += ",\n";
+      first = false;
+      out.append(depth + 1, ' ');
+      append_lines(out, e, depth + 1);
+    }
+    out += '\n';
+    out.append(depth, ' ');
+    out += ']';
+  } else {
+    out += j.dump();
+  }
+}
+
+}  // namespace
+
+std::string json_lines(const nlohmann::json& j) {
+  std::string out;
+  append_lines(out, j, 0);
+  out += '\n';
+  return out;
+}
 
 AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   struct stat st {};
