@@ -113,7 +113,7 @@ STUDY_TARGETS := study-convergence study-long-horizon study-stability study-work
 
 GEOMETRY_FIGURES := plots/geometry_momentum.png plots/geometry_extrinsic.png
 
-figures: $(FIGURES) $(COMPANION_FIGURES) $(STUDY_TARGETS) $(GEOMETRY_FIGURES) results/step_costs.json results/summary.md readme-tables
+figures: $(FIGURES) $(COMPANION_FIGURES) $(STUDY_TARGETS) $(GEOMETRY_FIGURES) sweep results/states.json results/step_costs.json results/summary.md readme-tables
 
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
@@ -153,7 +153,7 @@ $(eval $(call STUDY,stability,study-stability))
 $(eval $(call STUDY,work_precision,study-work-precision))
 $(eval $(call STUDY,poincare,study-poincare))
 
-results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
+results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json results/states.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
 	$< --threads $(JOBS) -o $@
 
 # ---- The geometry of the discrete flow (issue 5): eq. 24, eq. 17, Remark 3.3 ---
@@ -168,6 +168,7 @@ plots/geometry_%.png: plots/geometry_%.gp plots/style.gp results/geometry.json
 # measure CPU time; the work-precision figures are drawn after the benchmarks.
 results/work_precision.json: $(BUILD)/bin/study_work_precision $(SCENES) \
     | results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json $(RUNS) \
+      results/fate_map.json sweep results/states.json \
       $(COMPANION_RUNS) study-convergence study-long-horizon study-stability study-poincare study-geometry \
       $(FIGURES) $(COMPANION_FIGURES)
 	$< --threads $(JOBS) -o $@
@@ -190,13 +191,14 @@ results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 # Markdown tables of the results (results/summary.md), and the README's
 # generated tables copied from it and from `nhi list --markdown`.
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
-    results/stability.json results/step_costs.json $(RUNS) $(COMPANION_RUNS)
+    results/stability.json results/geometry.json results/fate_map.json results/states.json results/step_costs.json \
+    $(RUNS) $(COMPANION_RUNS)
 	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
 readme-tables: results/summary.md $(NHI)
 	d=$$(mktemp -d) && { $(NHI) list --markdown > $$d/list.md && \
 	  experiments/readme_tables.sh results/summary.md $$d/list.md; rc=$$?; rm -rf $$d; exit $$rc; }
 
-# ---- The sweep of issue 14 (not part of reproduce): a fate map over h x epsilon
+# ---- The sweep (part of reproduce): a fate map over h x epsilon
 # x methods x 100 initial states on the contact oscillators, sharded over MPI
 # ranks like every study.  RANKS=N runs it under mpirun with N ranks of
 # THREADS threads each (default: one process of $(JOBS) threads); the result is

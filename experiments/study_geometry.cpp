@@ -7,9 +7,13 @@
 //    DLA: energy and constraint along a run, and errors at T = 2 over h.
 //  - "holonomic": Remark 3.3 on the circle, the omega-DLA and the eq.-17 (g) DLA:
 //    energy and the radius along a run.
+//  - "reversibility": every fixed-step method's symmetry and rho-reversibility
+//    defects (reversibility.hpp) at each scene file's h, the largest over
+//    kStates states on the constraint along an RK4 run from the scene's state.
 // Initial states come from the scene files; the tests (tests/test_geometry.cpp,
 // tests/test_embedding.cpp) assert what these series show.
 #include "nhi/dla_body.hpp"
+#include "nhi/reversibility.hpp"
 #include "nhi/systems/circle.hpp"
 #include "nhi/systems/robot_extrinsic.hpp"
 #include "study.hpp"
@@ -52,6 +56,47 @@ json momentum_run(const S& sys, double alpha, double h, long steps, const Vec<do
   j["status"] = rep.ok ? "ok" : "failed";
   if (!rep.ok) j["reason"] = rep.reason;
   return j;
+}
+
+constexpr int kStates = 8;         // states per scene for the map defects
+constexpr long kStateStride = 25;  // steps of h between them
+
+// The map defects of every fixed-step method on one scene (reversibility.hpp).
+json reversibility_of(const json& scene) {
+  return nhi::visit_scene(scene, [&](const auto& sys, const auto& q0, const auto& v0) {
+    using S = std::decay_t<decltype(sys)>;
+    const double h = scene["h"].get<double>();
+    std::vector<Vec<double, S::n>> qs, vs;
+    nhi::run_method(sys, nhi::spec_of("rk4"), q0, v0, h, kStates * kStateStride, [&](const nhi::Sample<S::n, S::m>& s) {
+      if (s.k % kStateStride == 0 && qs.size() < size_t(kStates)) {
+        qs.push_back(s.q);
+        vs.push_back(nhi::project_to_constraint(sys, s.q, s.v));
+      }
+      return true;
+    });
+    json methods = json::array();
+    for (const nhi::StudyMethod& m : study::methods(study::fixed_step)) {
+      const nhi::MethodTraits t = nhi::method_traits(sys, m.spec);
+      nhi::MapDefects worst;
+      for (size_t i = 0; i < qs.size(); ++i) {
+        const nhi::MapDefects d = nhi::map_defects(sys, m.spec, qs[i], vs[i], h);
+        worst.ok = worst.ok && d.ok;
+        worst.symmetry_q = std::max(worst.symmetry_q, d.symmetry_q);
+        worst.symmetry_phase = std::max(worst.symmetry_phase, d.symmetry_phase);
+        worst.reversibility_q = std::max(worst.reversibility_q, d.reversibility_q);
+        worst.reversibility_phase = std::max(worst.reversibility_phase, d.reversibility_phase);
+      }
+      methods.push_back({{"label", m.label()},
+                         {"symmetric", t.symmetric},
+                         {"symmetric_in_phase", t.symmetric_in_phase},
+                         {"status", worst.ok ? "ok" : "failed"},
+                         {"symmetry_defect_q", worst.symmetry_q},
+                         {"symmetry_defect_phase", worst.symmetry_phase},
+                         {"reversibility_defect_q", worst.reversibility_q},
+                         {"reversibility_defect_phase", worst.reversibility_phase}});
+    }
+    return json{{"h", h}, {"reversible", nhi::is_reversible<S>::value}, {"states", qs.size()}, {"methods", methods}};
+  });
 }
 
 struct ChartRun {
@@ -123,7 +168,8 @@ int main(int argc, char** argv) {
     const double h = 0.2;
     const long steps = 2000;
 
-    std::vector<json> slots(8);
+    const std::vector<std::string> scenes = study::scene_names(o);
+    std::vector<json> slots(8 + scenes.size());
     std::vector<std::function<void()>> tasks;
     tasks.push_back([&] { slots[0] = momentum_run(particle, 0.5, h, steps, pq0, pv0); });
     tasks.push_back([&] { slots[1] = momentum_run(particle, 0.25, h, steps, pq0, pv0); });
@@ -177,12 +223,20 @@ int main(int argc, char** argv) {
                   {"g", series(nhi::DlaStepper<nhi::CircleHolonomic, nhi::AlphaDiscretization>(
                             nhi::CircleHolonomic{}, nhi::AlphaDiscretization{0.5}))}};
     });
+    for (const std::string& name : scenes) {
+      const json sc = study::scene(o, name);
+      tasks.push_back([&slots, sc, i = tasks.size()] { slots[i] = reversibility_of(sc); });
+    }
     // Task i fills slots[i]; estimated costs in RK4 steps (the reduced flow's
     // 200000 steps dominate the convergence task).
-    const std::vector<double> cost = {12000, 12000, 20000, 20000, 12000, 12000, 220000, 30000};
-    const std::vector<const char*> names = {
-        "momentum particle a=1/2", "momentum particle a=1/4", "momentum robot a=1/2", "momentum robot a=1/4",
-        "robot intrinsic",         "robot extrinsic",         "robot convergence",    "circle (Remark 3.3)"};
+    std::vector<double> cost = {12000, 12000, 20000, 20000, 12000, 12000, 220000, 30000};
+    std::vector<std::string> names = {"momentum particle a=1/2", "momentum particle a=1/4", "momentum robot a=1/2",
+                                      "momentum robot a=1/4",    "robot intrinsic",         "robot extrinsic",
+                                      "robot convergence",       "circle (Remark 3.3)"};
+    for (const std::string& name : scenes) {
+      cost.push_back(30000);
+      names.push_back("reversibility " + name);
+    }
     study::Cells cells;
     cells.label = "geometry";
     cells.count = tasks.size();
@@ -191,7 +245,7 @@ int main(int argc, char** argv) {
       return slots[i];
     };
     cells.cost = [&](size_t i) { return cost[i]; };
-    cells.name = [&](size_t i) { return std::string(names[i]); };
+    cells.name = [&](size_t i) { return names[i]; };
     slots = study::map_cells(o, cells);
     out = {{"study", "geometry"},
            {"momentum",
@@ -199,6 +253,13 @@ int main(int argc, char** argv) {
              {"robot", {{"runs", {slots[2], slots[3]}}}}}},
            {"extrinsic", {{"h", h}, {"intrinsic", slots[4]}, {"extrinsic", slots[5]}, {"convergence", slots[6]}}},
            {"holonomic", {{"circle", slots[7]}}}};
+    json& rev = out["reversibility"];
+    rev["rho"] = "(q, v) -> (q, -v)";
+    rev["defect"] =
+        "max over the states of |rho Phi_h rho Phi_h z - z| (reversibility) and |Phi_-h Phi_h z - z| (symmetry), "
+        "in q and in (q, v), relative to 1 + max|z| + max|Phi_h z|; rho is applied through the method's start "
+        "(reversibility.hpp)";
+    for (size_t i = 0; i < scenes.size(); ++i) rev["scenes"][scenes[i]] = slots[8 + i];
   } catch (const std::exception& e) {
     std::cerr << "study_geometry: error: " << e.what() << "\n";
     return 1;

@@ -53,18 +53,22 @@ echo
 
 echo "## Long horizon (results/long_horizon.json): 10^6 steps of the scene's h (0.2 on the paper's scenes: T = 2e5); the reference solution $(jq -r '.config.reference_steps // 1000000 | "\(.) steps"' "$R/long_horizon.json")"
 echo
-echo "| scene | method | max \\|E-E0\\| | drift rate (per unit t) | envelope exponent | max \\|constraint\\| | fate | CPU s |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "The fate is read from the last decade [T/10, T] (lib/nhi/fate.hpp; levels in the result's config): max |E-E0| at T/10^4 and at T, relative to |E0|; the running max's log-log slope over the last decade; the block means' rise over it."
+echo
+echo "| scene | method | max \\|E-E0\\| at T/1e4 | at T | / \\|E0\\| | last-decade slope | block-mean rise | max \\|constraint\\| | fate | CPU s |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
 jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] |
-  "| \($s) | \(.label) | \(.summary.max_abs_energy_error | g) | \(.summary.drift_rate | g) | \(.summary.envelope_growth_exponent | g) | \(.summary.max_abs_constraint | g) | \(.fate | gsub("[|]"; "\\|")) | \(.cpu_seconds | g) |"' "$R/long_horizon.json"
+  "| \($s) | \(.label) | \(.tail.max_early | g) | \(.summary.max_abs_energy_error | g) | \(.tail.relative | g) | \(.tail.max_slope | g) | \(.tail.block_rise | g) | \(.summary.max_abs_constraint | g) | \(.fate | gsub("[|]"; "\\|")) | \(.cpu_seconds | g) |"' "$R/long_horizon.json"
 echo
 
 echo "### Long horizon: the other first integrals (contact oscillators: H_y = (y^2 + yd^2)/2, R = H - H_y)"
 echo
-echo "| scene | method | max \\|H_y - H_y0\\| | max \\|R - R0\\| | R - R0 at the end | fate of E |"
+echo "Offset or drift, read like the energy's fate from the last decade of the running max error (fate.hpp, read_integral)."
+echo
+echo "| scene | method | H_y | R | R - R0 at the end | fate of E |"
 echo "|---|---|---|---|---|---|"
 jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] | select(.first_integrals != null) |
-  "| \($s) | \(.label) | \(.summary.max_abs_H_y_error | g) | \(.summary.max_abs_R_error | g) | \(.first_integrals.R.final_error | g) | \(.fate | gsub("[|]"; "\\|")) |"' "$R/long_horizon.json"
+  "| \($s) | \(.label) | \(.first_integrals.H_y.reading.words) | \(.first_integrals.R.reading.words) | \(.first_integrals.R.final_error | g) | \(.fate | gsub("[|]"; "\\|")) |"' "$R/long_horizon.json"
 echo
 
 if [ -f "$R/poincare.json" ]; then
@@ -267,6 +271,39 @@ jq -r "$G$WP$CLASSICAL"'
   ([$best[] | select(.label | classical)][0]) as $rk |
   if ($best | length) == 0 then "| \($s) | \($h)\($tag) | \($tol | g) | none reaches it | - | - | - | - | - |"
   else "| \($s) | \($h)\($tag) | \($tol | g) | \($best[0].label) (\($best[0].param | g)) | \($best[0].cpu | g) | \(if ($best | length) > 1 then $best[1].label else "-" end) | \(if ($best | length) > 1 then ($best[1].cpu / $best[0].cpu | g) else "-" end) | \(if $rk then $rk.label else "none" end) | \(if $rk then ($rk.cpu / $best[0].cpu | g) else "-" end) |" end' "$R/work_precision.json"
+
+# ---- Drift counted over initial states (study_states) ----------------------
+if [ -f "$R/states.json" ]; then
+echo "## Drift over initial states (results/states.json)"
+echo
+jq -r '"\(.config.states) initial states (the scene'"'"'s section family: H = 3/2, H_y = 1/2, zd0 = 0, z0 spread over +-0.9 sqrt 2), \(.config.steps) steps of h each; \"drifting\": the run failed or its last decade grows above round-off (lib/nhi/fate.hpp; an error below \(.config.fate_levels.roundoff_relative) |E0| that grows is round-off adding up). Slope: the running max of |E - E0| over the last decade, median [min, max] over the states; error at T: |E(T) - E0| / |E0|, median (max)."' "$R/states.json"
+echo
+echo "| scene | epsilon | h | method | drifting | last-decade slope | error at T |"
+echo "|---|---|---|---|---|---|---|"
+jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.cases[] | . as $c | .methods[] |
+  "| \($s) | \($c.epsilon) | \($c.h | g) | \(.label) | \(.drifting) of \(.runs | length)\(if .failed > 0 then " (\(.failed) failed)" else "" end)\(if .at_roundoff > 0 then " (\(.at_roundoff) growing at round-off)" else "" end) | \(.median_slope | g) [\(.min_slope | g), \(.max_slope | g)] | \(.median_relative_error_at_T | g) (\(.max_relative_error_at_T | g)) |"' "$R/states.json"
+echo
+echo "### Drift over initial states, by method: states drifting of 10 at (epsilon, h) = $(jq -r '[.scenes | to_entries[0].value.cases[] | "(\(.epsilon), \(.h * 1000 | round / 1000))"] | join(", ")' "$R/states.json")"
+echo
+echo "| method | $(jq -r '[.scenes | keys_unsorted[]] | join(" | ")' "$R/states.json") |"
+echo "|---|$(jq -r '[.scenes | keys_unsorted[] | "---"] | join("|")' "$R/states.json")|"
+jq -r '(.scenes | keys_unsorted) as $sc | [.scenes[$sc[]] | [.cases[].methods] | transpose] | transpose[] |
+  "| \(.[0][0].label) | " + (map(map(.drifting | tostring) | join(", ")) | join(" | ")) + " |"' "$R/states.json"
+echo
+fi
+
+# ---- Symmetry and reversibility of the one-step maps (study_geometry) -------
+if [ -f "$R/geometry.json" ] && jq -e '.reversibility' "$R/geometry.json" > /dev/null; then
+echo "## Symmetry and reversibility of the maps (results/geometry.json, \"reversibility\")"
+echo
+jq -r '"One step of each scene file'"'"'s h from \(.reversibility.scenes | to_entries[0].value.states) states on the constraint along an RK4 run; the largest relative defect: symmetry |Phi_-h Phi_h z - z|, reversibility under rho(q, v) = (q, -v) |rho Phi_h rho Phi_h z - z|, in q and in (q, v). The DLA is a map of (q, p mod omega^T): its defects are statements in q only."' "$R/geometry.json"
+echo
+echo "| scene | reversible scene | method | symmetric | symmetry, q | symmetry, (q, v) | reversibility, q | reversibility, (q, v) |"
+echo "|---|---|---|---|---|---|---|---|"
+jq -r "$G"'.reversibility.scenes | to_entries[] | .key as $s | .value as $v | $v.methods[] |
+  "| \($s) | \(if $v.reversible then "yes" else "no" end) | \(.label) | \(if .symmetric then "yes" else "no" end) | \(.symmetry_defect_q | g) | \(.symmetry_defect_phase | g) | \(.reversibility_defect_q | g) | \(.reversibility_defect_phase | g) |"' "$R/geometry.json"
+echo
+fi
 
 # ---- The fate-map sweep (make sweep; not part of make reproduce) --------------
 if [ -f "$R/fate_map.json" ]; then
