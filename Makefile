@@ -109,7 +109,8 @@ plots/fig4b_robot_constraint.png: plots/constraint_new.gp plots/style.gp $(filte
 	$(call PLOT,results/robot_fig34,Figure 4b: mobile robot,2)
 
 # One figure per study and registered scene (see STUDY below).
-STUDY_TARGETS := study-convergence study-long-horizon study-stability study-work-precision study-poincare
+STUDY_TARGETS := study-convergence study-long-horizon study-stability study-work-precision study-poincare \
+                 study-global-error
 
 GEOMETRY_FIGURES := plots/geometry_momentum.png plots/geometry_extrinsic.png
 
@@ -152,8 +153,10 @@ $(eval $(call STUDY,long_horizon,study-long-horizon))
 $(eval $(call STUDY,stability,study-stability))
 $(eval $(call STUDY,work_precision,study-work-precision))
 $(eval $(call STUDY,poincare,study-poincare))
+$(eval $(call STUDY,global_error,study-global-error))
 
-results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json results/states.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
+results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json results/states.json \
+    results/global_error.json: results/%.json: $(BUILD)/bin/study_% $(SCENES)
 	$< --threads $(JOBS) -o $@
 
 # ---- The geometry of the discrete flow (issue 5): eq. 24, eq. 17, Remark 3.3 ---
@@ -168,7 +171,7 @@ plots/geometry_%.png: plots/geometry_%.gp plots/style.gp results/geometry.json
 # measure CPU time; the work-precision figures are drawn after the benchmarks.
 results/work_precision.json: $(BUILD)/bin/study_work_precision $(SCENES) \
     | results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json $(RUNS) \
-      results/fate_map.json sweep results/states.json \
+      results/fate_map.json sweep results/states.json results/global_error.json study-global-error \
       $(COMPANION_RUNS) study-convergence study-long-horizon study-stability study-poincare study-geometry \
       $(FIGURES) $(COMPANION_FIGURES)
 	$< --threads $(JOBS) -o $@
@@ -191,7 +194,8 @@ results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 # Markdown tables of the results (results/summary.md), and the README's
 # generated tables copied from it and from `nhi list --markdown`.
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
-    results/stability.json results/geometry.json results/fate_map.json results/states.json results/step_costs.json \
+    results/stability.json results/geometry.json results/fate_map.json results/states.json results/global_error.json \
+    results/step_costs.json \
     $(RUNS) $(COMPANION_RUNS)
 	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
 readme-tables: results/summary.md $(NHI)

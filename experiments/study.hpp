@@ -386,6 +386,27 @@ json to_json(const nhi::Vec<double, N>& v) {
 }
 
 // q(T) of the reference solution at rtol = atol = tol.
+// Systems whose motion tends to a limit in closed form (the sleigh: limit_motion,
+// forward_speed): a run's error there is the error in the limit speed and heading.
+template <class S, class = void>
+struct has_limit_motion : std::false_type {};
+template <class S>
+struct has_limit_motion<S, std::void_t<decltype(&S::limit_motion), decltype(&S::forward_speed)>> : std::true_type {};
+
+// Adds "limit_speed_error" and "limit_heading_error" (the heading is q[2]) of
+// the late state (q, v) of a run from (q0, v0) to row, where the system has a closed-form limit and
+// the run has reached its settle time t_end (else nothing).
+template <class S>
+void add_limit_errors(const S& sys, const nhi::Vec<double, S::n>& q0, const nhi::Vec<double, S::n>& v0, double t_end,
+                      const nhi::Vec<double, S::n>& q, const nhi::Vec<double, S::n>& v, json* row) {
+  if constexpr (has_limit_motion<S>::value) {
+    double speed = 0, heading = 0, settle = 0;
+    if (!sys.limit_motion(q0, v0, &speed, &heading, &settle) || t_end < settle) return;
+    (*row)["limit_speed_error"] = std::abs(S::forward_speed(q, v) - speed);
+    (*row)["limit_heading_error"] = std::abs(q[2] - heading);
+  }
+}
+
 template <class S>
 nhi::Vec<double, S::n> reference_q(const S& sys, const nhi::Vec<double, S::n>& q0, const nhi::Vec<double, S::n>& v0,
                                    double T, double tol) {

@@ -42,6 +42,25 @@ json measure(const Vec<double, S::n>& qref, Run&& run) {
   return {{"status", "ok"}, {"error", (q - qref).cwiseAbs().maxCoeff()}, {"cpu_seconds", cpu}};
 }
 
+// Where the system's motion has a closed-form limit (the sleigh), the errors
+// in the limit speed and heading of a run of spec to the settle time.
+template <class S>
+void add_limit_errors(const S& sys, const nhi::MethodSpec& spec, const Vec<double, S::n>& q0,
+                      const Vec<double, S::n>& v0, double h, json* j) {
+  if constexpr (study::has_limit_motion<S>::value) {
+    double speed, heading, settle;
+    if ((*j)["status"] != "ok" || !sys.limit_motion(q0, v0, &speed, &heading, &settle)) return;
+    Vec<double, S::n> q = q0, v = v0;
+    double t = 0;
+    const nhi::RunReport rep = nhi::run_method(sys, spec, q0, v0, h, std::lround(std::ceil(settle / h)),
+                                               [&](const nhi::Sample<S::n, S::m>& s) {
+                                                 q = s.q, v = s.v, t = s.t;
+                                                 return true;
+                                               });
+    if (rep.ok) study::add_limit_errors(sys, q0, v0, t, q, v, j);
+  }
+}
+
 template <class S>
 std::vector<Variant> variants(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
                               const Vec<double, S::n>& qref) {
@@ -52,8 +71,10 @@ std::vector<Variant> variants(const S& sys, const Vec<double, S::n>& q0, const V
     const std::string family = spec.kind == "dla" ? spec.discretization : spec.kind;
     out.push_back({m.label(), family, spec.alpha,
                    [=, &sys](double h) {
-                     return measure<S>(
+                     json j = measure<S>(
                          qref, [&](auto&& obs) { return nhi::run_method(sys, spec, q0, v0, h, steps(h), obs); });
+                     add_limit_errors(sys, spec, q0, v0, h, &j);
+                     return j;
                    },
                    study::step_weight(spec)});
   }
@@ -141,6 +162,17 @@ int main(int argc, char** argv) {
                   {"alpha", vs[v].alpha}, {"h", hs},
                   {"error", errs},        {"runs", rs}};
         m.update(fit(hs, rs));
+        // The limit speed's and heading's errors (the sleigh) and their fitted orders.
+        for (const char* key : {"limit_speed_error", "limit_heading_error"}) {
+          if (!rs[0].contains(key)) continue;
+          json e = json::array(), as_runs = json::array();
+          for (const json& r : rs) {
+            e.push_back(r.contains(key) ? r[key] : json(nullptr));
+            as_runs.push_back(r.contains(key) ? json{{"status", "ok"}, {"error", r[key]}} : json{{"status", "failed"}});
+          }
+          m[key] = e;
+          m[std::string(key) + "_order"] = fit(hs, as_runs)["fitted_order"];
+        }
         methods.push_back(m);
       }
       return json{{"scene", sc},

@@ -263,6 +263,7 @@ int main(int argc, char** argv) {
         const bool ok1 = run(
             sys, c, q0, v0, kT_final, [&](double, const Vec<double, n>& q, const Vec<double, n>&) { qT = q; }, true);
         double maxE = 0, maxE_short = 0, t_end = 0;
+        Vec<double, n> q_end = q0, v_end = v0;
         long rhs_energy = 0, rhs_long = 0;  // right-hand sides of an external pair's runs
         const double cpu0 = study::thread_cpu_seconds();
         const bool ok2 = run(
@@ -271,6 +272,8 @@ int main(int argc, char** argv) {
               maxE = std::max(maxE, std::abs(nhi::energy(sys, q, v) - E0));
               if (t <= kT_energy_short * (1 + 1e-12)) maxE_short = maxE;
               t_end = t;
+              q_end = q;
+              v_end = v;
             },
             true, &rhs_energy);
         const double cpu_diagnosed = study::thread_cpu_seconds() - cpu0;
@@ -278,6 +281,7 @@ int main(int argc, char** argv) {
         row["final_error"] = (qT - qref).cwiseAbs().maxCoeff();
         row["max_energy_error"] = maxE;
         row["max_energy_error_short"] = maxE_short;
+        if (ok1 && ok2) study::add_limit_errors(sys, q0, v0, t_end, q_end, v_end, &row);
         if (!(ok1 && ok2)) {  // not timed: it is never ranked (and might not end unguarded)
           row["failure"] = "stopped at t = " + std::to_string(t_end) +
                            ": step failure, or |E - E0| above max(|E0|, 1) (the energy ran away)";

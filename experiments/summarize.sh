@@ -51,6 +51,18 @@ jq -r "$G"'
    "| \(.[0].label) | \(map(.fitted_order | g) | join(" | ")) |")' "$R/convergence.json"
 echo
 
+if jq -e '[.scenes[].methods[] | select(.limit_speed_error != null)] | length > 0' "$R/convergence.json" > /dev/null; then
+echo "### The limit motion (convergence study, scenes with a closed-form limit: the sleigh)"
+echo
+echo "Each method run from the scene's state to the settle time of the closed form (Sleigh::limit_motion: the turn rate below 2e-13 of its peak); error in the forward speed against c = sqrt(2E/m) and in the heading against theta_inf, at h = 0.2, 0.05 and 0.0125, and the fitted orders (as for q above)."
+echo
+echo "| scene | method | speed error, h = 0.2 | 0.05 | 0.0125 | order | heading error, h = 0.2 | 0.05 | 0.0125 | order |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
+jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] | select(.limit_speed_error != null) |
+  "| \($s) | \(.label) | \(.limit_speed_error[0] | g) | \(.limit_speed_error[2] | g) | \(.limit_speed_error[4] | g) | \(.limit_speed_error_order | g) | \(.limit_heading_error[0] | g) | \(.limit_heading_error[2] | g) | \(.limit_heading_error[4] | g) | \(.limit_heading_error_order | g) |"' "$R/convergence.json"
+echo
+fi
+
 echo "## Long horizon (results/long_horizon.json): 10^6 steps of the scene's h (0.2 on the paper's scenes: T = 2e5); the reference solution $(jq -r '.config.reference_steps // 1000000 | "\(.) steps"' "$R/long_horizon.json")"
 echo
 echo "The fate is read from the last decade [T/10, T] (lib/nhi/fate.hpp; levels in the result's config): max |E-E0| at T/10^4 and at T, relative to |E0|; the running max's log-log slope over the last decade; the block means' rise over it."
@@ -271,6 +283,19 @@ jq -r "$G$WP$CLASSICAL"'
   ([$best[] | select(.label | classical)][0]) as $rk |
   if ($best | length) == 0 then "| \($s) | \($h)\($tag) | \($tol | g) | none reaches it | - | - | - | - | - |"
   else "| \($s) | \($h)\($tag) | \($tol | g) | \($best[0].label) (\($best[0].param | g)) | \($best[0].cpu | g) | \(if ($best | length) > 1 then $best[1].label else "-" end) | \(if ($best | length) > 1 then ($best[1].cpu / $best[0].cpu | g) else "-" end) | \(if $rk then $rk.label else "none" end) | \(if $rk then ($rk.cpu / $best[0].cpu | g) else "-" end) |" end' "$R/work_precision.json"
+
+# ---- Growth of the global error (study_global_error) ------------------------
+if [ -f "$R/global_error.json" ]; then
+echo "## Growth of the global error (results/global_error.json)"
+echo
+jq -r '"\(.config.steps) steps of each integrable scene'"'"'s h; error max_i |q_i(t) - q_ref,i(t)| against the exact solution where there is one, else CVODE at 1e-13; growth exponent: the log-log slope of the error over [T/100, T] where it is between \(.config.floor) and \(.config.saturation) (1: linear growth, 2: quadratic; - where fewer than 3 checkpoints qualify; a fit over few points, the error near its floor or already O(1), says little)."' "$R/global_error.json"
+echo
+echo "| method | $(jq -r '[.scenes | keys_unsorted[]] | join(" | ")' "$R/global_error.json") |"
+echo "|---|$(jq -r '[.scenes | keys_unsorted[] | "---"] | join("|")' "$R/global_error.json")|"
+jq -r "$G"'(.scenes | keys_unsorted) as $sc | [.scenes[$sc[]].methods] | transpose[] |
+  "| \(.[0].label) | " + (map(if .status != "ok" then "failed" else "t^\(.growth_exponent | g) (\(.fit_points) points; \(.error[-1] | g) at T)" end) | join(" | ")) + " |"' "$R/global_error.json"
+echo
+fi
 
 # ---- Drift counted over initial states (study_states) ----------------------
 if [ -f "$R/states.json" ]; then

@@ -21,6 +21,15 @@ namespace nhi::test {
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
+// An energy error below this fraction of |E0| is round-off (FateLevels::roundoff_relative).
+constexpr double kRoundOffEnergy = 1e-10;
+
+// Systems whose index-reduced flow is a quadrature (rolling_disk.hpp): there
+// every Runge-Kutta method is symmetric, so "measurably not symmetric" is not asserted.
+template <class S, class = void>
+struct is_quadrature_flow : std::false_type {};
+template <class S>
+struct is_quadrature_flow<S, std::enable_if_t<S::quadrature_flow>> : std::true_type {};
 
 // Library methods with a fixed step (the reference solution is adaptive).
 std::vector<StudyMethod> fixed_step_methods() {
@@ -88,7 +97,16 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
     auto above = [&](const std::vector<double>& e) {
       return std::count_if(e.begin(), e.end(), [&](double x) { return x > kFloor; });
     };
-    auto enough = [&] { return above(eq) >= 3 && above(ev) >= 3 && (!fit_energy || above(eE) >= 3); };
+    // A reported velocity or energy exact to round-off at every h (on the rolling
+    // disk, whose velocities are constant in the body: the composed DLA's and
+    // mp06's velocity, mp06's energy) is of any order.
+    auto exact = [&](const std::vector<double>& e) {
+      return !e.empty() && *std::max_element(e.begin(), e.end()) <= kFloor;
+    };
+    auto v_exact = [&] { return exact(ev); };
+    auto enough = [&] {
+      return above(eq) >= 3 && (above(ev) >= 3 || v_exact()) && (!fit_energy || above(eE) >= 3 || exact(eE));
+    };
     // From a random state; where a method is so accurate there that even h = 0.8
     // leaves fewer than 3 errors above the floor (mp06+order6 on the sleigh, whose
     // random state turns slowly; a longer T does not help, the sleigh damps
@@ -126,7 +144,7 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
     struct {
       std::optional<double> order;
     } fq{asymptotic_order(hs, eq)}, fv{asymptotic_order(hs, ev)}, fE{asymptotic_order(hs, eE)};
-    if (!(fq.order && fv.order)) {
+    if (!(fq.order && (fv.order || v_exact()))) {
       std::string errs;
       for (size_t j = 0; j < hs.size(); ++j) {
         char buf[96];
@@ -135,8 +153,9 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
       }
       FAIL() << m.label() << ": too few points above the floor from the " << state << " state:" << errs;
     }
-    std::printf("    %-14s %s state, declared %d, fitted q %.3f, v %.3f, energy %s; q errors", m.label().c_str(), state,
-                p, *fq.order, *fv.order, fE.order ? std::to_string(*fE.order).c_str() : "-");
+    std::printf("    %-14s %s state, declared %d, fitted q %.3f, v %s, energy %s; q errors", m.label().c_str(), state,
+                p, *fq.order, fv.order ? std::to_string(*fv.order).c_str() : "exact",
+                fE.order ? std::to_string(*fE.order).c_str() : "-");
     for (double e : eq) std::printf(" %.2e", e);
     std::printf("\n");
     EXPECT_NEAR(*fq.order, p, tol) << m.label() << " (q)";
@@ -146,8 +165,9 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
     // is not fitted; a first-order velocity formula in a second-order method fails).
     const MethodTraits& t = traits;
     const int pv = t.velocity_order ? t.velocity_order : p;
-    EXPECT_GT(*fv.order, pv - tol) << m.label() << " (the reported velocity, declared order " << pv << ")";
-    if (p <= 2 && !t.preserves_energy) {  // (an energy-preserving method's is round-off)
+    if (fv.order)
+      EXPECT_GT(*fv.order, pv - tol) << m.label() << " (the reported velocity, declared order " << pv << ")";
+    if (p <= 2 && !t.preserves_energy && !exact(eE)) {  // (an energy-preserving method's is round-off)
       ASSERT_TRUE(fE.order) << m.label();
       EXPECT_GT(*fE.order, p - tol) << m.label() << " (energy)";
     }
@@ -187,7 +207,7 @@ TYPED_TEST(MethodContract, SymmetricMethodsAreReversibleAndOthersAreNot) {
             if (t.symmetric_in_phase) {
               EXPECT_LE(dz, 64 * kEps * t.stages) << m.label() << " h " << h;
             }
-          } else {
+          } else if (!is_quadrature_flow<S>::value) {
             // 100 times the symmetric methods' bound (RK4 on the sleigh returns to 1e-10).
             EXPECT_GT(dq, 100 * 64 * kEps * t.stages) << m.label() << " h " << h << ": a non-symmetric method returned";
           }
@@ -220,7 +240,8 @@ TYPED_TEST(MethodContract, SymmetricMethodsAreRhoReversibleExactlyOnReversibleSc
       // Two maps in two steppers, each within the symmetry contract's 64 eps per solve.
       const double bound = 2 * 64 * kEps * t.stages;
       if (!t.symmetric) {
-        EXPECT_GT(rev, 100 * bound) << m.label() << ": a non-symmetric method is rho-reversible";
+        if (!is_quadrature_flow<S>::value)
+          EXPECT_GT(rev, 100 * bound) << m.label() << ": a non-symmetric method is rho-reversible";
       } else if (is_reversible<S>::value) {
         EXPECT_LE(rev, bound) << m.label() << " (symmetry defect " << d.symmetry_phase << ")";
       } else {
@@ -346,7 +367,9 @@ TYPED_TEST(ReversibleSceneContract, SymmetricMethodsKeepTheEnergyBounded) {
       return true;
     });
     ASSERT_TRUE(rep.ok) << m.label() << ": " << rep.reason;
-    EXPECT_LE(last, 1.1 * first) << m.label() << ": first quarter " << first << ", last " << last;
+    // Round-off adding up is not growth (the rolling disk, where these methods keep E to round-off).
+    EXPECT_LE(last, std::max(1.1 * first, kRoundOffEnergy * std::abs(E0)))
+        << m.label() << ": first quarter " << first << ", last " << last;
   }
 }
 

@@ -131,6 +131,33 @@ TEST(Sleigh, TendsToStraightLineMotionAtTheLimitSpeed) {
   EXPECT_LT(std::abs(v[2]), 1e-10);          // the turn rate decays like sech
 }
 
+// The limit speed and heading in closed form against the reference solution at
+// the settle time limit_motion() gives, for the default and random sleighs,
+// forwards and backwards; none for the knife edge.
+TEST(Sleigh, LimitMotionIsTheReferencesLateMotion) {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(0.5, 2.0);
+  for (int trial = 0; trial < 4; ++trial) {
+    Sleigh sys;
+    Vec<double, 3> q0 = Sleigh::default_q0(), v0 = Sleigh::default_v0();
+    if (trial > 0) {
+      sys.mass = u(rng), sys.I = u(rng), sys.a = u(rng);
+      random_state<Sleigh>(rng, &q0, &v0, sys);
+    }
+    double speed = 0, heading = 0, T = 0;
+    ASSERT_TRUE(sys.limit_motion(q0, v0, &speed, &heading, &T));
+    Vec<double, 3> q, v;
+    reference_solution(sys, q0, v0, T, 1e-12, &q, &v);
+    const double forward = std::cos(q[2]) * v[0] + std::sin(q[2]) * v[1];
+    EXPECT_NEAR(forward, speed, 1e-9 * speed) << "trial " << trial;
+    EXPECT_NEAR(q[2], heading, 1e-9 * (1 + std::abs(heading))) << "trial " << trial;
+  }
+  Sleigh knife;
+  knife.a = 0.0;
+  double speed, heading;
+  EXPECT_FALSE(knife.limit_motion(Sleigh::default_q0(), Sleigh::default_v0(), &speed, &heading));
+}
+
 // Each registered system's scene file holds its default state and parameters.
 template <class S>
 class SceneFileTest : public ::testing::Test {};

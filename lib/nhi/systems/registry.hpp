@@ -12,16 +12,27 @@
 #include "nhi/systems/chaotic_oscillator.hpp"
 #include "nhi/systems/contact_oscillator.hpp"
 #include "nhi/systems/contact_oscillator_nr.hpp"
+#include "nhi/systems/magnetic_particle.hpp"
 #include "nhi/systems/particle.hpp"
 #include "nhi/systems/robot.hpp"
+#include "nhi/systems/rolling_disk.hpp"
 #include "nhi/systems/sleigh.hpp"
 #include "nhi/typelist.hpp"
 
 namespace nhi {
 
-// The registration line: X(Type) for each scene, in this order.
+// The registration: one X(Type) line for each scene, in this order.
+// clang-format off
 #define NHI_REGISTERED_SYSTEMS(X) \
-  X(Particle) X(Robot) X(ContactOscillator) X(ContactOscillatorNR) X(ChaoticOscillator) X(Sleigh)
+  X(Particle)                     \
+  X(Robot)                        \
+  X(ContactOscillator)            \
+  X(ContactOscillatorNR)          \
+  X(ChaoticOscillator)            \
+  X(Sleigh)                       \
+  X(RollingDisk)                  \
+  X(MagneticParticle)
+// clang-format on
 
 #define NHI_COMMA_THEN_(S) , S
 using Systems = typename Rest<TypeList<void NHI_REGISTERED_SYSTEMS(NHI_COMMA_THEN_)>>::type;

@@ -38,6 +38,7 @@
 // settle to straight-line motion at speed sqrt(3).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <cmath>
@@ -155,6 +156,37 @@ struct Sleigh {
     body(t, &u, &w, &th);
     *q << q0[0] + x, q0[1] + y, th;
     *v = inertial(t);
+    return true;
+  }
+
+  // The forward speed u = cos(theta) xd + sin(theta) yd (the body frame's).
+  static double forward_speed(const Vec<double, 3>& q, const Vec<double, 3>& v) {
+    return std::cos(q[2]) * v[0] + std::sin(q[2]) * v[1];
+  }
+
+  // The motion's limit as t -> infinity (g = 0, a > 0; false otherwise): the
+  // forward speed c = sqrt(2E/m) (u = c tanh(k (t - t*)) -> c) and the heading
+  //   theta_inf = theta0 + (w*/k) (pi/2 - gd(-k t*)),  gd(s) = atan(sinh s)
+  // (the closed form above with gd(+inf) = pi/2).  With w0 = 0 the sleigh
+  // keeps u0 and theta0.  *settle (may be null): a time after which the turn
+  // rate w* sech(k (t - t*)) is below 2 e^-30 ~ 2e-13 of its peak, t* + 30 / k.
+  bool limit_motion(const Vec<double, 3>& q0, const Vec<double, 3>& v0, double* speed, double* heading,
+                    double* settle = nullptr) const {
+    if (g != 0.0 || a == 0.0) return false;
+    const double th0 = q0[2], w0 = v0[2];
+    const double u0 = std::cos(th0) * v0[0] + std::sin(th0) * v0[1];
+    if (w0 == 0.0) {
+      *speed = u0;
+      *heading = th0;
+      if (settle) *settle = 0.0;
+      return true;
+    }
+    const double E = 0.5 * mass * u0 * u0 + 0.5 * (I + mass * a * a) * w0 * w0;
+    const double c = std::sqrt(2 * E / mass), k = mass * a * c / (I + mass * a * a);
+    const double ts = -std::atanh(u0 / c) / k, ws = w0 * std::cosh(k * ts);
+    if (settle) *settle = std::max(0.0, ts) + 30.0 / k;
+    *speed = c;
+    *heading = th0 + ws / k * (0.5 * M_PI - std::atan(std::sinh(-k * ts)));
     return true;
   }
 };
