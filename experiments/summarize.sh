@@ -195,9 +195,10 @@ def paper_dla: startswith("dla");
 '
 # Scene classes of the decision table (Modin & Verdier's: reversible or not,
 # integrable or not); a scene not listed is a class of its own.
-CLASSES='[{"name": "reversible, integrable", "scenes": ["particle", "robot", "contact_oscillator"]},
+CLASSES='[{"name": "reversible, integrable", "scenes": ["particle", "robot", "contact_oscillator", "rolling_disk"]},
           {"name": "reversible, chaotic", "scenes": ["chaotic_oscillator"]},
-          {"name": "not reversible", "scenes": ["contact_oscillator_nr"]},
+          {"name": "reversible flow, non-reversible maps", "scenes": ["contact_oscillator_nr"]},
+          {"name": "not reversible", "scenes": ["magnetic_particle"]},
           {"name": "reversible, attracted to a line", "scenes": ["sleigh"]}]'
 # input: work_precision.json; $classes as above.
 CLS='
@@ -288,7 +289,7 @@ jq -r "$G$WP$CLASSICAL"'
 if [ -f "$R/global_error.json" ]; then
 echo "## Growth of the global error (results/global_error.json)"
 echo
-jq -r '"\(.config.steps) steps of each integrable scene'"'"'s h; error max_i |q_i(t) - q_ref,i(t)| against the exact solution where there is one, else CVODE at 1e-13; growth exponent: the log-log slope of the error over [T/100, T] where it is between \(.config.floor) and \(.config.saturation) (1: linear growth, 2: quadratic; - where fewer than 3 checkpoints qualify; a fit over few points, the error near its floor or already O(1), says little)."' "$R/global_error.json"
+jq -r '"\(.config.steps) steps of h = \(.config.h) on each scene that declares itself integrable; error max_i |q_i(t) - q_ref,i(t)| against the exact solution where there is one, else CVODE at 1e-13; growth exponent: the log-log slope of the error over [T/100, T] where it is between \(.config.floor) and \(.config.saturation) (1: linear growth, 2: quadratic; - where fewer than 3 checkpoints qualify; a fit over few points, the error near its floor or already O(1), says little)."' "$R/global_error.json"
 echo
 echo "| method | $(jq -r '[.scenes | keys_unsorted[]] | join(" | ")' "$R/global_error.json") |"
 echo "|---|$(jq -r '[.scenes | keys_unsorted[] | "---"] | join("|")' "$R/global_error.json")|"
