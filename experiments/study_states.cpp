@@ -23,7 +23,7 @@ using nhi::Vec;
 using study::json;
 
 constexpr int kStates = 10;
-constexpr long kSteps = 150000;
+constexpr long kSteps = 100000;
 constexpr double kOtherH = 0.15;
 
 struct Case {
