@@ -171,7 +171,7 @@ plots/geometry_%.png: plots/geometry_%.gp plots/style.gp results/geometry.json
 # measure CPU time; the work-precision figures are drawn after the benchmarks.
 results/work_precision.json: $(BUILD)/bin/study_work_precision $(SCENES) \
     | results/convergence.json results/long_horizon.json results/stability.json results/geometry.json results/poincare.json $(RUNS) \
-      results/fate_map.json sweep results/states.json results/global_error.json study-global-error \
+      results/fate_map.json results/fate_map_roots.json sweep results/states.json results/global_error.json study-global-error \
       $(COMPANION_RUNS) study-convergence study-long-horizon study-stability study-poincare study-geometry \
       $(FIGURES) $(COMPANION_FIGURES)
 	$< --threads $(JOBS) -o $@
@@ -194,8 +194,8 @@ results/step_costs.json: $(BUILD)/bin/bench_steps | results/work_precision.json
 # Markdown tables of the results (results/summary.md), and the README's
 # generated tables copied from it and from `nhi list --markdown`.
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
-    results/stability.json results/geometry.json results/fate_map.json results/states.json results/global_error.json \
-    results/step_costs.json \
+    results/stability.json results/geometry.json results/fate_map.json results/fate_map_roots.json results/states.json \
+    results/global_error.json results/step_costs.json \
     $(RUNS) $(COMPANION_RUNS)
 	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
 readme-tables: results/summary.md $(NHI)
@@ -211,10 +211,17 @@ RANKS ?= 1
 THREADS ?= $(JOBS)
 # Open MPI refuses to run as root (containers, CI) without this flag.
 MPIRUN = mpirun $(if $(filter 0,$(shell id -u)),--allow-run-as-root,)
-sweep: results/fate_map.json
+sweep: results/fate_map.json results/fate_map_roots.json
 	$(MAKE) --no-print-directory $$(jq -r '.scenes | keys_unsorted[] | "plots/fate_map_" + . + ".png"' $<)
 results/fate_map.json: $(BUILD)/bin/study_fate_map $(SCENES)
 	$(if $(filter-out 1,$(RANKS)),$(MPIRUN) -np $(RANKS),) $< --threads $(THREADS) -o $@
+# Which root the implicit methods follow at h >= 1, with the method's own start
+# and from the root continued from h -> 0; epsilon = 0.1 (ROOT_VALUES) keeps
+# make reproduce short, the study takes any list (e.g. ROOT_VALUES=0.1,0.3,1,3).
+ROOT_VALUES ?= 0.1
+results/fate_map_roots.json: $(BUILD)/bin/study_fate_map $(SCENES) | results/fate_map.json
+	$(if $(filter-out 1,$(RANKS)),$(MPIRUN) -np $(RANKS),) $< --roots --h-min 1 --values $(ROOT_VALUES) \
+	  --threads $(THREADS) -o $@
 plots/fate_map_%.png: plots/fate_map.gp plots/style.gp results/fate_map.json
 	gnuplot -e "file='results/fate_map.json'; scene='$*'; out='$@'" $<
 # Its run time with 1, 2 and 4 ranks of one thread each (4 oversubscribes

@@ -19,6 +19,14 @@
 // N runs (a string, one letter per initial state), their counts, and the
 // median over the runs of max |E - E0| / |E0|.  Sharded over MPI ranks by
 // study::map_cells (cluster.hpp) like every study; stats.busy_seconds per rank.
+//   --roots (results/fate_map_roots.json, over h >= 1): the implicit methods
+// only, each cell run twice, with the method's own start (checking at every
+// step whether the root it takes is the one continued from h -> 0,
+// solver.hpp) and from that continued root, so that a limit can be told
+// apart from its solver's start.  Per cell also a root letter:
+//   c  every step took the continued root
+//   o  some step took another root
+//   x  some step had no root continued from h -> 0 (the branch folded)
 #include <algorithm>
 #include <cmath>
 
@@ -36,6 +44,7 @@ struct Grid {
   std::vector<nhi::StudyMethod> methods;
   int states = 100;
   double T = 50;
+  bool roots = false;
   size_t count() const { return scenes.size() * values.size() * methods.size() * hs.size() * states; }
   // Cell i as (scene, value, method, h, state) indices, the state varying fastest.
   std::array<size_t, 5> split(size_t i) const {
@@ -49,11 +58,13 @@ struct Grid {
   }
 };
 
-// One run: [fate letter, max |E - E0| / |E0|, steps taken].
-json run_cell(const Grid& g, size_t i) {
+// One run: [fate letter, max |E - E0| / |E0|, steps taken]; *rep_out (may be
+// null) gets its report.
+json run_fate(const Grid& g, size_t i, const nhi::MethodSpec& spec, nhi::RunReport* rep_out) {
   const auto [s, e, m_, j, k_] = g.split(i);
   const double h = g.hs[j];
-  const auto m = m_, k = k_;  // a lambda may not capture a structured binding (C++17)
+  const auto k = k_;  // a lambda may not capture a structured binding (C++17)
+  (void)m_;
   return nhi::visit_scene(g.scene_at[s][e], [&](const auto& sys, const auto&, const auto&) -> json {
     using S = std::decay_t<decltype(sys)>;
     if constexpr (nhi::has_section_states<S>::value) {
@@ -64,27 +75,43 @@ json run_cell(const Grid& g, size_t i) {
       double max_dE = 0;
       long taken = 0;
       char fate = 's';
-      const nhi::RunReport rep =
-          nhi::run_method(sys, g.methods[m].spec, q0, v0, h, steps, [&](const nhi::Sample<S::n, S::m>& smp) {
-            const double dE = std::abs(nhi::energy(sys, smp.q, smp.v) - E0);
-            if (!std::isfinite(dE) || !nhi::all_finite(smp.q)) {
-              fate = 'n';
-              return false;
-            }
-            max_dE = std::max(max_dE, dE);
-            taken = smp.k;
-            if (dE > scale) {
-              fate = 'e';
-              return false;
-            }
-            return true;
-          });
+      const nhi::RunReport rep = nhi::run_method(sys, spec, q0, v0, h, steps, [&](const nhi::Sample<S::n, S::m>& smp) {
+        const double dE = std::abs(nhi::energy(sys, smp.q, smp.v) - E0);
+        if (!std::isfinite(dE) || !nhi::all_finite(smp.q)) {
+          fate = 'n';
+          return false;
+        }
+        max_dE = std::max(max_dE, dE);
+        taken = smp.k;
+        if (dE > scale) {
+          fate = 'e';
+          return false;
+        }
+        return true;
+      });
       if (fate == 's' && !rep.ok) fate = rep.failure == nhi::FailureKind::kNonFinite ? 'n' : 'f';
+      if (rep_out) *rep_out = rep;
       return json::array({std::string(1, fate), max_dE / scale, taken});
     } else {
       throw std::logic_error("scene without a section family in the fate map");
     }
   });
+}
+
+// One cell: run_fate with the method's own start; with --roots also the root
+// letter (above) and the run from the continued root:
+// [fate, rel, taken, root letter, fate, rel, taken].
+json run_cell(const Grid& g, size_t i) {
+  nhi::MethodSpec spec = g.methods[g.split(i)[2]].spec;
+  if (!g.roots) return run_fate(g, i, spec, nullptr);
+  spec.root_check = true;
+  nhi::RunReport rep;
+  json r = run_fate(g, i, spec, &rep);
+  r.push_back(rep.no_continued_root_steps > 0 ? "x" : rep.other_root_steps > 0 ? "o" : "c");
+  spec.root_check = false;
+  spec.start = "continuation";
+  for (const json& x : run_fate(g, i, spec, nullptr)) r.push_back(x);
+  return r;
 }
 
 double median(std::vector<double> v) {
@@ -111,6 +138,7 @@ int main(int argc, char** argv) {
   app.add_option("--h-min", h_min, "Smallest h")->check(CLI::PositiveNumber);
   app.add_option("--h-max", h_max, "Largest h")->check(CLI::PositiveNumber);
   app.add_option("--per-decade", per_decade, "Grid points of h per decade")->check(CLI::Range(1, 1000));
+  app.add_flag("--roots", g.roots, "Implicit methods only: check each step's root and run from the continued root too");
   study::parse(app, argc, argv);
   if (!(h_max > h_min)) {
     std::cerr << "study_fate_map: --h-max must exceed --h-min\n";
@@ -119,6 +147,15 @@ int main(int argc, char** argv) {
   const int points = static_cast<int>(std::floor(per_decade * std::log10(h_max / h_min) + 1e-9));
   for (int i = 0; i <= points; ++i) g.hs.push_back(h_min * std::pow(10.0, double(i) / per_decade));
   g.methods = study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
+  if (g.roots) {  // (implicit or not is a method's trait for every system: asked of the particle's)
+    std::vector<nhi::StudyMethod> implicit;
+    for (const auto& m : g.methods)
+      if (nhi::visit_scene(
+              nhi::validate_scene(study::scene(opt, study::scene_names(opt).front())),
+              [&](const auto& sys, const auto&, const auto&) { return nhi::method_traits(sys, m.spec).implicit; }))
+        implicit.push_back(m);
+    g.methods = implicit;
+  }
 
   try {
     for (const std::string& name : study::scene_names(opt)) {
@@ -154,7 +191,9 @@ int main(int argc, char** argv) {
   cells.run = [&](size_t i) { return run_cell(g, i); };
   cells.cost = [&](size_t i) {
     const auto ix = g.split(i);
-    return g.T / g.hs[ix[3]] * study::step_weight(g.methods[ix[2]].spec);
+    // (--roots: a checked step costs about 2 + h / continuation_dh solves, a continued one one fewer)
+    const double solves = g.roots ? 3 + 2 * g.hs[ix[3]] / nhi::SolverOptions{}.continuation_dh : 1.0;
+    return g.T / g.hs[ix[3]] * study::step_weight(g.methods[ix[2]].spec) * solves;
   };
   cells.name = [&](size_t i) {
     const auto ix = g.split(i);
@@ -175,10 +214,15 @@ int main(int argc, char** argv) {
              nonfinite = json::array(), med = json::array();
         json largest_all = nullptr, largest_half = nullptr;
         bool all_broken = false, half_broken = false;
+        // --roots: the root letters, the continued runs' fates and their limits.
+        json root_letters = json::array(), other_root = json::array(), fates_c = json::array(),
+             stable_c = json::array();
+        json largest_all_c = nullptr, largest_half_c = nullptr;
+        bool all_broken_c = false, half_broken_c = false;
         for (size_t j = 0; j < g.hs.size(); ++j) {
-          std::string f;
+          std::string f, roots, fc;
           std::vector<double> rel;
-          int c[4] = {0, 0, 0, 0};
+          int c[4] = {0, 0, 0, 0}, others = 0, stable_cont = 0;
           for (int k = 0; k < g.states; ++k, ++i) {
             const json& r = runs[i];
             const char letter = r[0].get<std::string>()[0];
@@ -186,6 +230,23 @@ int main(int argc, char** argv) {
             c[letter == 's' ? 0 : letter == 'e' ? 1 : letter == 'f' ? 2 : 3]++;
             if (std::isfinite(r[1].get<double>())) rel.push_back(r[1].get<double>());
             total_steps += r[2].get<long>();
+            if (g.roots) {
+              roots += r[3].get<std::string>();
+              others += r[3] != "c";
+              fc += r[4].get<std::string>();
+              stable_cont += r[4] == "s";
+              total_steps += r[6].get<long>();
+            }
+          }
+          if (g.roots) {
+            root_letters.push_back(roots);
+            other_root.push_back(others);
+            fates_c.push_back(fc);
+            stable_c.push_back(stable_cont);
+            if (stable_cont != g.states) all_broken_c = true;
+            if (2 * stable_cont < g.states) half_broken_c = true;
+            if (!all_broken_c) largest_all_c = g.hs[j];
+            if (!half_broken_c) largest_half_c = g.hs[j];
           }
           fates.push_back(f);
           stable.push_back(c[0]);
@@ -199,7 +260,7 @@ int main(int argc, char** argv) {
           if (!all_broken) largest_all = g.hs[j];
           if (!half_broken) largest_half = g.hs[j];
         }
-        ms.push_back({{"label", g.methods[m].label()},
+        json entry = {{"label", g.methods[m].label()},
                       {"fates", fates},
                       {"stable", stable},
                       {"energy", energy},
@@ -207,7 +268,16 @@ int main(int argc, char** argv) {
                       {"non_finite", nonfinite},
                       {"median_max_rel_energy_error", med},
                       {"largest_h_all_stable", largest_all},
-                      {"largest_h_half_stable", largest_half}});
+                      {"largest_h_half_stable", largest_half}};
+        if (g.roots) {
+          entry["roots"] = root_letters;
+          entry["other_root"] = other_root;
+          entry["fates_continued"] = fates_c;
+          entry["stable_continued"] = stable_c;
+          entry["largest_h_all_stable_continued"] = largest_all_c;
+          entry["largest_h_half_stable_continued"] = largest_half_c;
+        }
+        ms.push_back(entry);
       }
       by_value.push_back({{"value", g.values[e]}, {"methods", ms}});
     }
@@ -225,7 +295,12 @@ int main(int argc, char** argv) {
                     "s: stable (reached T, |E - E0| <= |E0| throughout); e: |E - E0| passed |E0| (stopped there); f: a "
                     "step solve did not converge; n: non-finite state or energy"},
                    {"largest_h_all_stable", "largest grid h such that at every grid h up to it every run is stable"},
-                   {"largest_h_half_stable", "the same with at least half the runs stable"}}},
+                   {"largest_h_half_stable", "the same with at least half the runs stable"},
+                   {"roots", g.roots},
+                   {"root_letters",
+                    "--roots: c every step took the root continued from h -> 0; o some step took another; x some step "
+                    "had no continued root. fates_continued: the runs whose every step starts from the continued root; "
+                    "other_root: states whose run with the method's own start left the continued root"}}},
                  {"size",
                   {{"runs", g.count()},
                    {"steps", total_steps},

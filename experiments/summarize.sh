@@ -104,6 +104,15 @@ echo "|---|---|---|---|---|"
 jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] |
   "| \($s) | \(.label) | \(if .largest_stable_h then (.largest_stable_h | g) else "none" end) | \(if .first_failure then "h = \(.first_failure.h | g): \(.first_failure.failure.kind) at t = \(.first_failure.failure.time | g)" else "-" end) | \(if .largest_surviving_h then (.largest_surviving_h | g) else "none" end) |"' "$R/stability.json"
 echo
+echo "### Stability and the solver's start: the implicit methods"
+echo
+jq -r '"Largest stable h of each implicit method with its own start (the predictor) and with every step started from the root continued from h -> 0 (h >= \(.config.roots.h_from)), and the largest h up to which the runs with the predictor took the continued root at every step. Where the two limits differ, the limit with the predictor is partly that of its solver."' "$R/stability.json"
+echo
+echo "| scene | method | largest stable h, own start | from the continued root | own start followed the continued root up to |"
+echo "|---|---|---|---|---|"
+jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] | select(.roots) |
+  "| \($s) | \(.label) | \(if .largest_stable_h then (.largest_stable_h | g) else "none" end) | \(if .roots.largest_stable_h_continued then (.roots.largest_stable_h_continued | g) else "none" end) | \(if .roots.followed_continued_root_up_to then (.roots.followed_continued_root_up_to | g) else "none" end) |"' "$R/stability.json"
+echo
 
 echo "## Step costs (results/step_costs.json), CPU ns per step (CVODE: ms per run to T = 200)"
 echo
@@ -345,6 +354,19 @@ jq -r "$G"'
   (.scenes | to_entries[] | .key as $s | .value.by_value as $bv |
    ($bv[0].methods | map(.label))[] as $l |
    "| \($s) | \($l) | " + ([$bv[] | .methods[] | select(.label == $l) | .largest_h_all_stable | g] | join(" | ")) + " |")' "$R/fate_map.json"
+fi
+if [ -f "$R/fate_map_roots.json" ]; then
+echo
+echo "## Fate map and the solver's start (results/fate_map_roots.json): stable runs out of $(jq .config.states "$R/fate_map_roots.json")"
+echo
+jq -r '"The implicit methods at h >= \(.config.h | min), \(.config.param) = \(.config.values | map(tostring) | join(", ")): per h, the stable runs with the method'"'"'s own start / from the root continued from h -> 0 / the runs whose own start left the continued root at some step."' "$R/fate_map_roots.json"
+echo
+jq -r "$G"'
+  .config.h as $h |
+  "| scene | value | method | " + ($h | map("h = \(. | g)") | join(" | ")) + " |",
+  "|---|---|---|" + ($h | map("---|") | join("")),
+  (.scenes | to_entries[] | .key as $s | .value.by_value[] | .value as $e | .methods[] |
+   . as $m | "| \($s) | \($e) | \(.label) | " + ([range(0; $h | length)] | map("\($m.stable[.]) / \($m.stable_continued[.]) / \($m.other_root[.])") | join(" | ")) + " |")' "$R/fate_map_roots.json"
 fi
 if [ -f "$R/fate_map_scaling.json" ]; then
 echo

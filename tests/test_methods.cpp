@@ -321,6 +321,36 @@ TYPED_TEST(MethodContract, ReportedSamplesAndSolvesAreWhatTheMethodPromises) {
   }
 }
 
+// At a moderate h the implicit function theorem leaves one root near the
+// state, and the method's own start must find it: every step of every
+// implicit method on every scene, h = 0.05, 200 steps, takes the root
+// continued from h -> 0 (solver.hpp, root following), and a run that starts
+// every solve from that continued root ends where the predictor's run does
+// (to the solves' tolerance, grown over the run).
+TYPED_TEST(MethodContract, AtModerateHEveryStepTakesTheRootContinuedFromZero) {
+  using S = TypeParam;
+  const S sys = make_system<S>();
+  const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
+  const double h = 0.05;
+  const long steps = 200;
+  for (const StudyMethod& sm : fixed_step_methods()) {
+    if (!method_traits(sys, sm.spec).implicit) continue;
+    MethodSpec checked = sm.spec, continued = sm.spec;
+    checked.root_check = true;
+    continued.start = "continuation";
+    const Final<S> a = run_to_end(sys, checked, q0, v0, h, steps);
+    ASSERT_TRUE(a.rep.ok) << sm.label() << ": " << a.rep.reason;
+    EXPECT_EQ(a.rep.root_checked_steps, a.rep.steps_taken) << sm.label();
+    EXPECT_EQ(a.rep.other_root_steps, 0) << sm.label();
+    EXPECT_EQ(a.rep.no_continued_root_steps, 0) << sm.label();
+    const Final<S> b = run_to_end(sys, continued, q0, v0, h, steps);
+    ASSERT_TRUE(b.rep.ok) << sm.label() << ": " << b.rep.reason;
+    EXPECT_EQ(b.rep.root_checked_steps, b.rep.steps_taken) << sm.label();
+    const double scale = 1 + a.q.cwiseAbs().maxCoeff();
+    EXPECT_LE((a.q - b.q).cwiseAbs().maxCoeff(), 1e-8 * scale) << sm.label();
+  }
+}
+
 // The DLA's multipliers are the constraint force of the index-reduced ODE:
 // p_{k+1} = p_k + h dL/dq - omega^T lambda_k (midpoint), against
 // d/dt dL/dqdot = dL/dq + omega^T lambda(t), so lambda_k = -h lambda(t_k) + O(h^2),

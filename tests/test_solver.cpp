@@ -130,5 +130,93 @@ TYPED_TEST(FailurePathTest, FailuresGoThroughTheSharedPath) {
   }
 }
 
+// Root following (solver.hpp) on a scalar problem whose roots are known:
+//     r(y) = (y - h (1 + y^2)) (y - 10).
+// The first factor's roots are y = (1 -+ sqrt(1 - 4 h^2)) / 2h: the one that
+// tends to 0 as h -> 0 (the continued root) and one near 1/h; they meet in a
+// fold at h = 1/2 and do not exist beyond.  The second factor's root, 10,
+// exists for every h but is not continued from h -> 0.
+struct FoldProblem {
+  static constexpr int ny = 1, nl = 0;
+  double h;
+  Mat<double, 1, 0> W_t;
+  const Mat<double, 1, 0>& Wt() const { return W_t; }
+  Vec<double, 1> y_scale(const Vec<double, 1>& y) const { return y.cwiseAbs(); }
+  template <class T>
+  void residual(const Vec<T, 1>& y, const Vec<T, 0>&, Vec<T, 1>* r, Vec<double, 1>* terms) const {
+    const T f = y[0] - h * (1.0 + y[0] * y[0]), g = y[0] - 10.0;
+    (*r)[0] = f * g;
+    if (terms) {
+      const double yv = value_of(y[0]);
+      (*terms)[0] = (std::abs(yv) + std::abs(h) * (1 + yv * yv)) * (std::abs(yv) + 10);
+    }
+  }
+  FoldProblem at_step(double h2) const { return FoldProblem{h2, W_t}; }
+  void small_step_start(double ratio, Vec<double, 1>* y, Vec<double, 0>*) const { (*y)[0] *= ratio; }
+};
+
+double continued_root(double h) { return (1 - std::sqrt(1 - 4 * h * h)) / (2 * h); }
+
+StepSummary solve_fold(double h, double start, double* y_out, bool continuation, bool root_check) {
+  FoldProblem p{h, {}};
+  SolverOptions opt;
+  opt.continuation = continuation;
+  opt.root_check = root_check;
+  Vec<double, 1> y;
+  y[0] = start;
+  Vec<double, 0> none;
+  const StepSummary s = NewtonSolver<FoldProblem>(p, opt).solve(&y, &none);
+  *y_out = y[0];
+  return s;
+}
+
+TEST(RootFollowing, ContinuationFindsTheRootFromZeroWhereTheStartFindsAnother) {
+  static_assert(has_continuation<FoldProblem>::value);
+  for (const double h : {0.1, 0.3, 0.45}) {
+    const double yc = continued_root(h), y_far = (1 + std::sqrt(1 - 4 * h * h)) / (2 * h);
+    for (const double start : {y_far * 1.02, 9.6, 0.9 * yc}) {
+      double y = 0;
+      // The start decides the root...
+      const StepSummary plain = solve_fold(h, start, &y, false, false);
+      ASSERT_TRUE(plain.ok()) << h << " " << start;
+      EXPECT_EQ(plain.root, RootCheck::kUnchecked);
+      const bool near_continued = std::abs(y - yc) <= 1e-10 * (1 + yc);
+      EXPECT_TRUE(near_continued || std::abs(y - y_far) <= 1e-10 * y_far || std::abs(y - 10) <= 1e-10)
+          << h << " " << start << " -> " << y;
+      // ... the root check says which one it was (and leaves the root as it is) ...
+      double y_checked = 0;
+      const StepSummary checked = solve_fold(h, start, &y_checked, false, true);
+      ASSERT_TRUE(checked.ok());
+      EXPECT_EQ(y_checked, y);
+      EXPECT_EQ(checked.root, near_continued ? RootCheck::kContinued : RootCheck::kOther) << h << " " << start;
+      // ... and continuation finds the continued root from any start.
+      double y_cont = 0;
+      const StepSummary cont = solve_fold(h, start, &y_cont, true, false);
+      ASSERT_TRUE(cont.ok()) << cont.message;
+      EXPECT_EQ(cont.root, RootCheck::kContinued);
+      EXPECT_NEAR(y_cont, yc, 1e-10 * (1 + yc)) << h << " " << start;
+    }
+  }
+}
+
+TEST(RootFollowing, BeyondTheFoldNoRootIsContinued) {
+  double y = 0;
+  // Newton from 9.6 finds 10, which no continuation from h -> 0 reaches.
+  const StepSummary checked = solve_fold(0.6, 9.6, &y, false, true);
+  ASSERT_TRUE(checked.ok());
+  EXPECT_NEAR(y, 10.0, 1e-10);
+  EXPECT_EQ(checked.root, RootCheck::kNotFound);
+  const StepSummary cont = solve_fold(0.6, 9.6, &y, true, false);
+  EXPECT_FALSE(cont.ok());
+  EXPECT_EQ(cont.failure, FailureKind::kSolve);
+  // It names where the branch was lost: at the fold, h = 1/2, to the continuation's resolution.
+  const std::string key = "no root continued from h -> 0 beyond h = ";
+  const size_t at = cont.message.find(key);
+  ASSERT_NE(at, std::string::npos) << cont.message;
+  const double lost = std::stod(cont.message.substr(at + key.size()));
+  EXPECT_GE(lost, 0.45) << cont.message;
+  EXPECT_LE(lost, 0.5) << cont.message;
+}
+
 }  // namespace
 }  // namespace nhi::test

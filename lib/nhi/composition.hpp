@@ -154,6 +154,7 @@ class Composed {
       total.jacobians += s.jacobians;
       total.rhs_evaluations += s.rhs_evaluations;
       total.used_fallback = total.used_fallback || s.used_fallback;
+      total.merge_root(s.root);
       total.relative_residual = std::max(total.relative_residual, s.relative_residual);
       if (!s.ok()) {
         total.status = SolveStatus::kFailed;

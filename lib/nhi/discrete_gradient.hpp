@@ -51,6 +51,14 @@ struct DiscreteGradientProblem {
 
   const Mat<double, ny, nl>& Wt() const { return W_t; }
 
+  // Root following (solver.hpp): the same step at h2; as h -> 0 the root
+  // tends to (q0, p0) with a multiplier of the size of a force.
+  DiscreteGradientProblem at_step(double h2) const { return DiscreteGradientProblem(sys, h2, q0, p0); }
+  void small_step_start(double ratio, Vec<double, ny>* y, Vec<double, nl>*) const {
+    y->template head<n>() = q0 + ratio * (y->template head<n>() - q0);
+    y->template segment<n>(n) = p0 + ratio * (y->template segment<n>(n) - p0);
+  }
+
   Vec<double, ny> y_scale(const Vec<double, ny>& y) const {
     Vec<double, ny> s;
     s << q0.cwiseAbs() + y.template head<n>().cwiseAbs(), p0.cwiseAbs() + y.template segment<n>(n).cwiseAbs(),
@@ -69,8 +77,8 @@ struct DiscreteGradientProblem {
   // inlining at its function-growth limit and leaves the Jets' vector updates
   // as calls (on contact_oscillator_nr, whose H is not separable).
   template <class T>
-  [[gnu::flatten]] void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp, VecN* sq = nullptr,
-                         VecN* sp = nullptr, T* c_out = nullptr) const {
+  [[gnu::flatten]] void discrete_gradient(const Vec<T, n>& q1, const Vec<T, n>& p1, Vec<T, n>* Dq, Vec<T, n>* Dp,
+                                          VecN* sq = nullptr, VecN* sp = nullptr, T* c_out = nullptr) const {
     const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1), pb = cst<T>(0.5) * (p0.template cast<T>() + p1);
     const Vec<T, n> gq = -force(sys, qb, pb), gp = velocity(sys, qb, pb);
     const Vec<T, n> dq = q1 - q0.template cast<T>(), dp = p1 - p0.template cast<T>();
@@ -278,8 +286,7 @@ struct DiscreteGradientMethod {
   static std::string label(const MethodSpec&) { return name; }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
-    SolverOptions opt;
-    opt.tolerance = spec.tolerance;
+    const SolverOptions opt = solver_options(spec);
     return with_composition(DiscreteGradientStepper<S>(sys, opt), spec.composition, f);
   }
   static std::vector<StudyEntry> study_entries() {

@@ -106,7 +106,7 @@ StepSummary DiscreteGradientStepper<S>::map(double h, const VecN& q0, const VecN
     // bookkeeping (a copy of the iterate, a comparison) runs only on a
     // check_settled_passes(true) stepper, so that neither is on the common
     // path.
-    if (settled && settled_by_move_) {
+    if (settled && settled_by_move_ && !options_.continuation) {
       ++settled_by_move_steps_;
       if (check_settled_) {
         const Vec<double, Problem::ny> y_settled = y;
@@ -117,9 +117,13 @@ StepSummary DiscreteGradientStepper<S>::map(double h, const VecN& q0, const VecN
         return s;
       }
       if (options_.tolerance >= 16 * std::numeric_limits<double>::epsilon()) {
-        unpack(y, q1, p1, lambda);
         StepSummary s;
         s.status = SolveStatus::kConverged;
+        if (options_.root_check) {  // continued from the explicit guess, Newton's start (before unpack sets *lambda)
+          Vec<double, 0> none;
+          s.root = NewtonSolver<Problem>(prob, options_).check_root(y, none, explicit_guess(), none);
+        }
+        unpack(y, q1, p1, lambda);
         return s;
       }
     }

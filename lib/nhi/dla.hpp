@@ -126,6 +126,20 @@ struct DlaStepProblem {
 
   const Mat<double, n, mc>& Wt() const { return W_t; }
 
+  // Root following (solver.hpp): the same step at h2 (W_t is omega(q_k)^T,
+  // independent of h); as h -> 0 the root tends to q_{k+1} = q_k with
+  // multipliers 0 (they carry the factor h, as L_d does).
+  DlaStepProblem at_step(double h2) const {
+    DlaStepProblem c = *this;
+    c.h = h2;
+    c.d2_valid_ = false;
+    return c;
+  }
+  void small_step_start(double ratio, VecN* q1, Vec<double, mc>* lambda) const {
+    *q1 = q_curr + ratio * (*q1 - q_curr);
+    *lambda *= ratio;
+  }
+
   using Memo = OmegaMemo<S, std::tuple_size<decltype(std::declval<const D&>().constraint_nodes())>::value>;
   Memo* memo = nullptr;  // omega at the constraint nodes, for the double residual (may be null)
   // D2 L_d(q_k, q1) at the q1 of the last double residual (d2_at_), for

@@ -60,6 +60,7 @@ class ComposedDla {
       total.evaluations += s.evaluations;
       total.jacobians += s.jacobians;
       total.used_fallback = total.used_fallback || s.used_fallback;
+      total.merge_root(s.root);
       total.relative_residual = std::max(total.relative_residual, s.relative_residual);
       if (!s.ok()) {
         total.status = SolveStatus::kFailed;

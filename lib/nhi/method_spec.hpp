@@ -15,6 +15,12 @@ struct MethodSpec {
   double alpha = 0.5;
   double tolerance = 1e-12;          // implicit methods: relative residual; the reference: CVODE rtol = atol
   std::string composition = "none";  // symmetric methods: composition.hpp
+  // Implicit methods: the start of each step's solve.  "predictor": the
+  // method's own (extrapolation, passes); "continuation": the root continued
+  // from h -> 0 (solver.hpp, root following).  root_check: with the
+  // predictor, also report whether each step's root is the continued one.
+  std::string start = "predictor";
+  bool root_check = false;
 
   // The one label scheme, the key of a method's style in plots/style.gp:
   // the method's own label (its struct's label(spec): "dla a=0.5", "dla-sym a=0",

@@ -56,8 +56,7 @@ struct DlaMethod {
   }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
-    DlaOptions opt;
-    opt.tolerance = spec.tolerance;
+    const DlaOptions opt = solver_options(spec);
     if (spec.composition != "none") {
       if (!symmetric(spec)) throw std::invalid_argument("the DLA composes only with a self-adjoint discretization");
       const Composition& c = composition(spec.composition);

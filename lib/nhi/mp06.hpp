@@ -143,16 +143,24 @@ struct Mp06Problem {
 
   const S& sys;
   double h;
-  VecN p0, q_half, F0;      // F0 = F(q_half, p0)
+  VecN q0, p0, q_half, F0;  // F0 = F(q_half, p0)
   Mat<double, ny, nl> W_t;  // h omega(q_half)^T
 
-  Mp06Problem(const S& s, double hh, const VecN& q0, const VecN& p) : sys(s), h(hh), p0(p) {
+  Mp06Problem(const S& s, double hh, const VecN& q, const VecN& p) : sys(s), h(hh), q0(q), p0(p) {
     q_half = q0 + 0.5 * h * velocity<S, double>(sys, q0, p0);
     F0 = force<S, double>(sys, q_half, p0);
     W_t = h * sys.template omega<double>(q_half).transpose();
   }
 
   const Mat<double, ny, nl>& Wt() const { return W_t; }
+
+  // Root following (solver.hpp): the same step at h2; as h -> 0 the root
+  // tends to v1 = V(q0, p0), with a multiplier of the size of a force.
+  Mp06Problem at_step(double h2) const { return Mp06Problem(sys, h2, q0, p0); }
+  void small_step_start(double ratio, Vec<double, ny>* v1, Vec<double, nl>*) const {
+    const VecN v0 = velocity<S, double>(sys, q0, p0);
+    *v1 = v0 + ratio * (*v1 - v0);
+  }
 
   Vec<double, ny> y_scale(const Vec<double, ny>& v1) const { return v1.cwiseAbs(); }
 
@@ -212,12 +220,13 @@ struct Mp06SeparableProblem {
   const S& sys;
   const Velocity& V;
   double h;
+  VecN q0, p0;
   VecN q_half, p_base;      // p1 = p_base + h omega(q_half)^T lambda, p_base = p0 + h F(q_half)
   Mat<double, n, m> hWt;    // h omega(q_half)^T
   Mat<double, ny, nl> W_t;  // empty
 
-  Mp06SeparableProblem(const S& s, const Velocity& vel, double hh, const VecN& q0, const VecN& p0)
-      : sys(s), V(vel), h(hh) {
+  Mp06SeparableProblem(const S& s, const Velocity& vel, double hh, const VecN& q, const VecN& p)
+      : sys(s), V(vel), h(hh), q0(q), p0(p) {
     q_half = q0 + 0.5 * h * V(p0);
     // F(q_half, p) does not depend on p here, so (h/2)(F(q_half, p0) + F(q_half, p1)) = h F(q_half, p0).
     p_base = p0 + h * force<S, double>(sys, q_half, p0);
@@ -226,6 +235,11 @@ struct Mp06SeparableProblem {
 
   const Mat<double, ny, nl>& Wt() const { return W_t; }
   Vec<double, ny> y_scale(const Vec<double, ny>& lambda) const { return lambda.cwiseAbs(); }
+
+  // Root following (solver.hpp): the same step at h2; the unknown, the
+  // multiplier, has the size of a force and a finite limit as h -> 0.
+  Mp06SeparableProblem at_step(double h2) const { return Mp06SeparableProblem(sys, V, h2, q0, p0); }
+  void small_step_start(double, Vec<double, ny>*, Vec<double, nl>*) const {}
 
   template <class T>
   void state(const Vec<T, m>& lambda, Vec<T, n>* q1, Vec<T, n>* p1, Vec<T, n>* v1) const {
@@ -343,7 +357,11 @@ class Mp06Stepper {
                             VecM* lambda) const {
     StepSummary s;
     const Mp06SeparableProblem<S, Velocity> prob(sys_, V, h, q0, p0);
-    if (explicit_ && explicit_map(prob, q1, p1, lambda, &s)) return s;
+    if (explicit_ && explicit_map(prob, q1, p1, lambda, &s)) {
+      // Linear equations in the multiplier: their one root is the continued one.
+      if (options_.follows_roots()) s.root = RootCheck::kContinued;
+      return s;
+    }
     VecM y = *lambda;
     Vec<double, 0> none;
     s = NewtonSolver<Mp06SeparableProblem<S, Velocity>>(prob, options_).solve(&y, &none);
@@ -439,8 +457,7 @@ struct Mp06Method {
   static std::string label(const MethodSpec&) { return name; }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
-    SolverOptions opt;
-    opt.tolerance = spec.tolerance;
+    const SolverOptions opt = solver_options(spec);
     return with_composition(Mp06Stepper<S>(sys, opt), spec.composition, f);
   }
   static std::vector<StudyEntry> study_entries() {

@@ -16,6 +16,9 @@
 //   tolerance      number in (0, 1): implicit methods' relative residual (default 1e-12),
 //                  CVODE rtol = atol for the benchmark (default 1e-12); unused by rk4
 //   output_every   integer >= 1: record steps 0, s, 2s, ... and the last (default 1)
+//   start          "predictor" | "continuation": where an implicit method's step
+//                  solve starts, its own predictor or the root continued from
+//                  h -> 0 (solver.hpp)                          (default "predictor")
 // Every number must be finite and at most 1e100 in magnitude.
 // Unknown keys are rejected (a misspelt key must not silently fall back to a default).
 // validate_scene() returns the resolved scene with every default filled in, or

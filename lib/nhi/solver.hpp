@@ -34,6 +34,23 @@
 // check; newton() computes it only for a residual within tolerance but above
 // 16 eps of the scale without it, where it decides between accepting and
 // iterating (has_rounding_terms below).
+//   Root following.  At a large h the equations of an implicit step can have
+// several roots, and the start decides which one Newton finds.  A Problem
+// that also provides
+//   P at_step(double h2) const;   // the same step (same state) at step size h2
+//   void small_step_start(double ratio, Vec<double,ny>* y, Vec<double,nl>* lambda) const;
+//       // a start for step ratio*h from one for h: the root's h -> 0 limit
+//       // plus ratio times the start's offset from it (ratio = 0: the limit)
+// and a member `double h` can be solved along the root continued from h -> 0
+// (SolverOptions::continuation): natural-parameter continuation in h with
+// sub-steps of at most continuation_dh (at least two), each started from the
+// secant through the last two roots (the first from the root's h -> 0
+// limit), Newton only (the fallback could jump branches), the sub-step halved (down to 1/64 of it) where Newton fails.
+// If that still fails, the branch from h -> 0 has folded before h (or turned
+// too sharply to follow), and the step has no continued root.  With
+// root_check the step is solved from the caller's start as usual and then
+// continued as well, and StepSummary::root says whether the two agree
+// (has_continuation below).
 #pragma once
 
 #include <ceres/tiny_solver.h>
@@ -47,11 +64,22 @@
 #include <type_traits>
 #include <utility>
 
+#include "nhi/method_spec.hpp"
 #include "nhi/stepper.hpp"
 
 namespace nhi {
 
 // Does the Problem provide rounding_terms() (above)?
+// Does the Problem provide at_step() and small_step_start() (above)?
+template <class P, class = void>
+struct has_continuation : std::false_type {};
+template <class P>
+struct has_continuation<P,
+                        std::void_t<decltype(std::declval<const P&>().at_step(0.0)),
+                                    decltype(std::declval<const P&>().small_step_start(
+                                        0.0, std::declval<Vec<double, P::ny>*>(), std::declval<Vec<double, P::nl>*>())),
+                                    decltype(std::declval<const P&>().h)>> : std::true_type {};
+
 template <class P, class = void>
 struct has_rounding_terms : std::false_type {};
 template <class P>
@@ -66,7 +94,23 @@ struct SolverOptions {
   // Keep the factorization (a chord step) while each iteration shrinks the
   // relative residual by at least this factor; refresh the Jacobian otherwise.
   double refresh_ratio = 1e-3;
+  // Root following (above): solve along the root continued from h -> 0
+  // instead of from the caller's start; or solve from the start and report
+  // whether its root is the continued one (StepSummary::root).
+  bool continuation = false;
+  bool root_check = false;
+  double continuation_dh = 0.05;  // largest sub-step of the continuation in h
+  bool follows_roots() const { return continuation || root_check; }
 };
+
+// The solver options a MethodSpec asks for (tolerance, root following).
+inline SolverOptions solver_options(const MethodSpec& spec) {
+  SolverOptions opt;
+  opt.tolerance = spec.tolerance;
+  opt.continuation = spec.start == "continuation";
+  opt.root_check = spec.root_check && !opt.continuation;
+  return opt;
+}
 
 template <class P>
 class NewtonSolver {
@@ -97,6 +141,127 @@ class NewtonSolver {
   // (dla.hpp, DlaStepper::polish).
   template <class Polish = NoPolish>
   Summary solve(VecY* y, VecL* lambda, bool check_guess = false, const Polish& polish = {}) const {
+    if constexpr (has_continuation<P>::value) {
+      if (options_.continuation) {
+        VecY yc = *y;
+        VecL lc = *lambda;
+        Summary s = continued(&yc, &lc, true);
+        if (s.ok()) {
+          *y = yc;
+          *lambda = lc;
+          s.root = RootCheck::kContinued;
+        }
+        return s;
+      }
+      if (options_.root_check) {
+        const VecY y0 = *y;
+        const VecL l0 = *lambda;
+        Summary s = solve_from_start(y, lambda, check_guess, polish);
+        if (s.ok()) s.root = check_root(*y, *lambda, y0, l0);
+        return s;
+      }
+    }
+    return solve_from_start(y, lambda, check_guess, polish);
+  }
+
+  // Is the solution (y, lambda) the root continued from h -> 0, starting the
+  // continuation from (y_start, l_start)?  (kUnchecked for a Problem without
+  // continuation.)
+  RootCheck check_root(const VecY& y, const VecL& lambda, VecY y_start, VecL l_start) const {
+    if constexpr (has_continuation<P>::value) {
+      const Summary c = continued(&y_start, &l_start, false);
+      if (!c.ok()) return RootCheck::kNotFound;
+      return same_root(y, lambda, y_start, l_start) ? RootCheck::kContinued : RootCheck::kOther;
+    } else {
+      return RootCheck::kUnchecked;
+    }
+  }
+
+  // Do two solutions agree beyond the solver's tolerance (1e-6 relative to
+  // their size plus one: distinct roots differ at the size of the state)?
+  static bool same_root(const VecY& y1, const VecL& l1, const VecY& y2, const VecL& l2) {
+    const auto close = [](const auto& a, const auto& b) {
+      if constexpr (std::decay_t<decltype(a)>::SizeAtCompileTime == 0) {
+        return true;
+      } else {
+        return (a - b).cwiseAbs().maxCoeff() <= 1e-6 * (1.0 + a.cwiseAbs().maxCoeff());
+      }
+    };
+    return close(y1, y2) && close(l1, l2);
+  }
+
+ private:
+  // The root continued from h -> 0 (above), from the start (y, lambda) for
+  // h; in_place: the last solve, at h itself, on this solver's problem (whose
+  // caches the caller reads), else on a copy.
+  Summary continued(VecY* y, VecL* lambda, bool in_place) const {
+    const double h = p_.h;
+    const int K = std::max(2, static_cast<int>(std::ceil(std::abs(h) / options_.continuation_dh)));
+    Options sub = options_;
+    sub.continuation = sub.root_check = false;
+    sub.fallback = false;
+    Summary total;
+    // (y_prev, l_prev) at parameter sa and (y_cur, l_cur) at sb are the last
+    // two points of the branch, in units of h; the first is the h -> 0 limit.
+    VecY y_prev = *y, y_cur = *y;
+    VecL l_prev = *lambda, l_cur = *lambda;
+    p_.small_step_start(0.0, &y_prev, &l_prev);
+    double sa = 0, sb = 0, ds = 1.0 / K;
+    const double ds_min = ds / 64;
+    while (sb < 1) {
+      const double s_next = std::min(1.0, sb + ds);
+      VecY yt;
+      VecL lt;
+      if (sb == 0) {  // the h -> 0 limit itself (the caller's start enters only through a multiplier that has one)
+        yt = y_prev;
+        lt = l_prev;
+      } else {  // the secant through the last two points
+        const double w = (s_next - sb) / (sb - sa);
+        yt = y_cur + w * (y_cur - y_prev);
+        lt = l_cur + w * (l_cur - l_prev);
+      }
+      Summary s;
+      if (s_next == 1 && in_place) {
+        s = NewtonSolver<P>(p_, sub).solve_from_start(&yt, &lt, false, NoPolish{});
+      } else {
+        const P pj = p_.at_step(s_next * h);
+        s = NewtonSolver<P>(pj, sub).solve_from_start(&yt, &lt, false, NoPolish{});
+      }
+      total.iterations += s.iterations;
+      total.evaluations += s.evaluations;
+      total.jacobians += s.jacobians;
+      if (!s.ok()) {
+        if (ds > ds_min) {
+          ds *= 0.5;
+          continue;
+        }
+        total.status = SolveStatus::kFailed;
+        total.failure = s.failure == FailureKind::kNonFinite ? FailureKind::kNonFinite : FailureKind::kSolve;
+        total.message = "no root continued from h -> 0 beyond h = " + std::to_string(sb * h) + " (of " +
+                        std::to_string(h) + "): " + s.message;
+        return total;
+      }
+      if (sb > 0) {
+        y_prev = y_cur;
+        l_prev = l_cur;
+      }
+      sa = sb;
+      sb = s_next;
+      y_cur = yt;
+      l_cur = lt;
+      total.relative_residual = s.relative_residual;
+      ds = std::min(2 * ds, 1.0 / K);
+    }
+    total.status = SolveStatus::kConverged;
+    *y = y_cur;
+    *lambda = l_cur;
+    return total;
+  }
+
+ public:
+  // solve() from the caller's start (y, lambda), without root following.
+  template <class Polish>
+  Summary solve_from_start(VecY* y, VecL* lambda, bool check_guess, const Polish& polish) const {
     if (check_guess) {
       Summary s;
       VecX r;

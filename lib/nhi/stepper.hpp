@@ -15,6 +15,7 @@
 // name.  See dla.hpp, rk4.hpp and reference.hpp for the three families.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <string>
 #include <utility>
@@ -51,6 +52,27 @@ inline const char* to_string(FailureKind k) {
   return "?";
 }
 
+// Which root of its implicit equations a step took, when asked
+// (SolverOptions::root_check, solver.hpp): the one continued from h -> 0, another
+// one, or none could be continued to h (the branch from h -> 0 folded or the
+// continuation's solve failed).  Ordered: a step of several solves (a
+// composition's stages) reports the largest of theirs.
+enum class RootCheck { kUnchecked, kContinued, kOther, kNotFound };
+
+inline const char* to_string(RootCheck r) {
+  switch (r) {
+    case RootCheck::kUnchecked:
+      return "unchecked";
+    case RootCheck::kContinued:
+      return "continued";
+    case RootCheck::kOther:
+      return "other";
+    case RootCheck::kNotFound:
+      return "no continued root";
+  }
+  return "?";
+}
+
 // One step (or one implicit solve): converged or failed and why, and its cost.
 struct StepSummary {
   SolveStatus status = SolveStatus::kFailed;
@@ -63,6 +85,9 @@ struct StepSummary {
   long rhs_evaluations = 0;  // explicit methods and the reference solution
   long internal_steps = 0;   // adaptive methods
   std::string message;       // why it failed, when it did
+  RootCheck root = RootCheck::kUnchecked;
+  // Merge the root check of another solve of the same step (a stage, a retry).
+  void merge_root(RootCheck r) { root = std::max(root, r); }
   bool ok() const { return status == SolveStatus::kConverged; }
 };
 
@@ -103,6 +128,11 @@ struct RunReport {
   long fallbacks = 0;        // implicit steps that needed the fallback solver
   long rhs_evaluations = 0;  // explicit methods and the reference solution
   long internal_steps = 0;   // adaptive methods
+  // With SolverOptions::root_check: steps whose root was checked, steps that
+  // took another root than the one continued from h -> 0, steps with no
+  // continued root, and the first step of either kind (-1: none).
+  long root_checked_steps = 0, other_root_steps = 0, no_continued_root_steps = 0;
+  long first_root_departure = -1;
   void fail(long step, FailureKind kind, std::string why) {
     ok = false;
     failure_step = step;
@@ -115,6 +145,10 @@ struct RunReport {
     fallbacks += s.used_fallback ? 1 : 0;
     rhs_evaluations += s.rhs_evaluations;
     internal_steps += s.internal_steps;
+    if (s.root != RootCheck::kUnchecked) ++root_checked_steps;
+    if (s.root == RootCheck::kOther) ++other_root_steps;
+    if (s.root == RootCheck::kNotFound) ++no_continued_root_steps;
+    if (first_root_departure < 0 && s.root >= RootCheck::kOther) first_root_departure = steps_taken;
   }
 };
 

@@ -20,8 +20,9 @@ namespace {
 
 using namespace scene_detail;
 
-const std::vector<std::string> kKeys = {"system", "params", "q0",    "v0",        "method",       "discretization",
-                                        "alpha",  "h",      "steps", "tolerance", "output_every", "composition"};
+const std::vector<std::string> kKeys = {"system",         "params",      "q0",   "v0",    "method",
+                                        "discretization", "alpha",       "h",    "steps", "tolerance",
+                                        "output_every",   "composition", "start"};
 
 long peak_rss_kb() {
   rusage ru{};
@@ -53,6 +54,7 @@ json run_system(const S& sys, const json& sc) {
   spec.alpha = alpha;
   spec.tolerance = tol;
   spec.composition = sc["composition"];
+  spec.start = sc["start"];
   const RunReport rep = run_method(sys, spec, q0, v0, h, steps, rec);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu = cpu_seconds() - cpu0;
@@ -243,6 +245,7 @@ json validate_scene(const json& scene) {
   const double alpha = scene.contains("alpha") ? finite_number(scene["alpha"], "alpha") : 0.5;
   if (!(alpha >= 0.0 && alpha <= 1.0)) fail("alpha", "must be in [0, 1], got " + show(scene["alpha"]));
   r["alpha"] = alpha;
+  r["start"] = scene.contains("start") ? one_of(scene["start"], "start", {"predictor", "continuation"}) : "predictor";
   r["composition"] =
       scene.contains("composition") ? one_of(scene["composition"], "composition", composition_names()) : "none";
   if (r["composition"] != "none") {
