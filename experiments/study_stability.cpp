@@ -11,7 +11,7 @@
 //   Roots.  At a large h an implicit step's equations can have several roots,
 // and the start of the solve decides which one a run follows, so a limit
 // found with the method's own start (its predictor) is partly the solver's.
-// For every implicit method and every grid h >= --roots-from (0.01: the whole grid), the run
+// For every implicit method and every grid h >= --roots-from (default 0.1), the run
 // with the predictor also checks at every step whether its root is the one
 // continued from h -> 0 (solver.hpp, root following; the check moves no
 // number of the run), and a second run starts every step's solve from that
@@ -20,7 +20,10 @@
 // every step.  Where no root can be continued to h (the branch from h -> 0
 // folds), the continued run fails there ("solve", "no root continued"): that
 // limit is the method's own; the predictor's is the method's together with
-// its solver.  Below --roots-from the starts are not compared.
+// its solver.  Below --roots-from the starts are not compared: checking the
+// whole grid (--roots-from 0.01) costs about ten times the study, and on the
+// registered scenes it finds every run below h = 0.1 on the continued root at
+// every step, with the same limits either way.
 #include "study.hpp"
 
 namespace {
@@ -101,7 +104,7 @@ int main(int argc, char** argv) {
   study::add_options(app, opt);
   double T = 200.0;
   app.add_option("--T", T, "Final time of every run")->check(CLI::PositiveNumber);
-  double roots_from = 0.01;
+  double roots_from = 0.1;
   app.add_option("--roots-from", roots_from, "Smallest h at which the implicit methods' roots are followed")
       ->check(CLI::PositiveNumber);
   study::parse(app, argc, argv);

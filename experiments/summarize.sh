@@ -106,12 +106,12 @@ jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] |
 echo
 echo "### Stability and the solver's start: the implicit methods"
 echo
-jq -r '"Largest stable h of each implicit method with its own start (the predictor) and with every step started from the root continued from h -> 0 (h >= \(.config.roots.h_from)), and the largest h up to which the runs with the predictor took the continued root at every step. Where the two limits differ, the limit with the predictor is partly that of its solver."' "$R/stability.json"
+jq -r '"Largest stable h of each implicit method with its own start (the predictor) and with every step started from the root continued from h -> 0 (checked at h >= \(.config.roots.h_from); \"< \(.config.roots.h_from)\": at no checked h), and the largest h up to which the runs with the predictor took the continued root at every step. Where the two limits differ, the limit with the predictor is partly that of its solver."' "$R/stability.json"
 echo
 echo "| scene | method | largest stable h, own start | from the continued root | own start followed the continued root up to |"
 echo "|---|---|---|---|---|"
-jq -r "$G"'.scenes | to_entries[] | .key as $s | .value.methods[] | select(.roots) |
-  "| \($s) | \(.label) | \(if .largest_stable_h then (.largest_stable_h | g) else "none" end) | \(if .roots.largest_stable_h_continued then (.roots.largest_stable_h_continued | g) else "none" end) | \(if .roots.followed_continued_root_up_to then (.roots.followed_continued_root_up_to | g) else "none" end) |"' "$R/stability.json"
+jq -r "$G"'.config.roots.h_from as $from | .scenes | to_entries[] | .key as $s | .value.methods[] | select(.roots) |
+  "| \($s) | \(.label) | \(if .largest_stable_h then (.largest_stable_h | g) else "none" end) | \(if .roots.largest_stable_h_continued then (.roots.largest_stable_h_continued | g) else "< \($from | g)" end) | \(if .roots.followed_continued_root_up_to then (.roots.followed_continued_root_up_to | g) else "< \($from | g)" end) |"' "$R/stability.json"
 echo
 
 echo "## Step costs (results/step_costs.json), CPU ns per step (CVODE: ms per run to T = 200)"
