@@ -39,6 +39,7 @@ std::string method_keys(const nhi::json& m) {
   std::string out = "\"method\": \"" + m["method"].get<std::string>() + "\"";
   if (!m["discretization"].is_null())
     out += ", \"discretization\": \"" + m["discretization"].get<std::string>() + "\", \"alpha\": " + num(m["alpha"]);
+  if (m.contains("stages") && !m["stages"].is_null()) out += ", \"stages\": " + num(m["stages"]);
   if (m["composition"] != "none") out += ", \"composition\": \"" + m["composition"].get<std::string>() + "\"";
   return out;
 }

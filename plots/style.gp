@@ -30,6 +30,9 @@ set style line 28 lc rgb "#d6a06b" pt 2  lw 1.5
 set style line 29 lc rgb "#7b4173" pt 3  lw 1.5
 set style line 30 lc rgb "#7f7f7f" pt 1  lw 1.5
 set style line 31 lc rgb "#000000" pt 2  lw 1.5
+set style line 32 lc rgb "#637939" pt 5  lw 1.5
+set style line 33 lc rgb "#8ca252" pt 7  lw 1.5
+set style line 34 lc rgb "#b5cf6b" pt 9  lw 1.5
 set style line 40 lc rgb "#aaaaaa" pt 1  lw 1.0
 method_ls(label) = \
   label eq "dla a=0.5" ? 11 : \
@@ -53,6 +56,9 @@ method_ls(label) = \
   label eq "discrete_gradient+order6" ? 29 : \
   label eq "rkf78" ? 30 : \
   label eq "dopri5" ? 31 : \
+  label eq "spark s=2" ? 32 : \
+  label eq "spark s=3" ? 33 : \
+  label eq "spark s=4" ? 34 : \
   40
 # One jq pass per figure: calling jq once per label and per data series would
 # start jq and parse the result hundreds of times a figure.  A script

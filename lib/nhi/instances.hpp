@@ -11,6 +11,7 @@
 #include "nhi/dla.hpp"
 #include "nhi/mp06.hpp"
 #include "nhi/reference.hpp"
+#include "nhi/spark.hpp"
 #include "nhi/systems/registry.hpp"
 
 // PREFIX template class X<S>; for every stepper the library compiles for S
@@ -22,6 +23,9 @@
   PREFIX template class nhi::Mp06Stepper<S, true>;                        \
   PREFIX template class nhi::Mp06Stepper<S, false>;                       \
   PREFIX template class nhi::DiscreteGradientStepper<S>;                  \
+  PREFIX template class nhi::SparkStepper<S, 2>;                          \
+  PREFIX template class nhi::SparkStepper<S, 3>;                          \
+  PREFIX template class nhi::SparkStepper<S, 4>;                          \
   PREFIX template class nhi::ReferenceStepper<S>;
 
 #define NHI_EXTERN_STEPPER_INSTANCES_(S) NHI_STEPPER_INSTANCES(extern, nhi::S)

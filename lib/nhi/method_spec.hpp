@@ -15,6 +15,7 @@ struct MethodSpec {
   double alpha = 0.5;
   double tolerance = 1e-12;          // implicit methods: relative residual; the reference: CVODE rtol = atol
   std::string composition = "none";  // symmetric methods: composition.hpp
+  int stages = 2;                    // spark: Lobatto IIIA-IIIB stages, 2, 3 or 4 (spark.hpp)
   // Implicit methods: the start of each step's solve.  "predictor": the
   // method's own (extrapolation, passes); "continuation": the root continued
   // from h -> 0 (solver.hpp, root following).  root_check: with the

@@ -35,6 +35,7 @@
 #include "nhi/reference.hpp"
 #include "nhi/rk4.hpp"
 #include "nhi/run.hpp"
+#include "nhi/spark.hpp"
 #include "nhi/typelist.hpp"
 
 namespace nhi {
@@ -131,7 +132,7 @@ struct ReferenceMethod {
 };
 
 // Every method the library has.
-using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod, Mp06Method, DiscreteGradientMethod>;
+using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod, Mp06Method, DiscreteGradientMethod, SparkMethod>;
 
 inline std::vector<std::string> method_names() {
   std::vector<std::string> names;

@@ -7,10 +7,12 @@
 //   method         a method's name (nhi list): "dla", "rk4", "benchmark", ...  (required)
 //   composition    "none" | "triple_jump" | "suzuki5" | "order6"  (default "none");
 //                  anything but "none" only with a symmetric method: mp06,
-//                  discrete_gradient, dla with alpha 0.5 or discretization "symmetric"
+//                  discrete_gradient, spark, dla with alpha 0.5 or discretization "symmetric"
 //   discretization "alpha" | "symmetric"                         (default "alpha")
 //   alpha          number in [0, 1]                              (default 0.5)
 //                  (discretization and alpha are the DLA's; other methods ignore them)
+//   stages         integer 2, 3 or 4: spark's Lobatto IIIA-IIIB stages, of order
+//                  2 stages - 2 (default 2; other methods ignore it)
 //   h              number > 0                                    (required)
 //   steps          integer >= 1                                  (required)
 //   tolerance      number in (0, 1): implicit methods' relative residual (default 1e-12),
@@ -71,5 +73,7 @@ json meta();
 
 // Names the runner knows (for messages and tests).
 std::vector<std::string> system_names();
+// The names of the registered methods (methods.hpp), for code that does not include the steppers.
+std::vector<std::string> registered_method_names();
 
 }  // namespace nhi

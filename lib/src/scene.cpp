@@ -22,7 +22,7 @@ using namespace scene_detail;
 
 const std::vector<std::string> kKeys = {"system",         "params",      "q0",   "v0",    "method",
                                         "discretization", "alpha",       "h",    "steps", "tolerance",
-                                        "output_every",   "composition", "start"};
+                                        "output_every",   "composition", "start", "stages"};
 
 long peak_rss_kb() {
   rusage ru{};
@@ -55,6 +55,7 @@ json run_system(const S& sys, const json& sc) {
   spec.tolerance = tol;
   spec.composition = sc["composition"];
   spec.start = sc["start"];
+  spec.stages = sc["stages"];
   const RunReport rep = run_method(sys, spec, q0, v0, h, steps, rec);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu = cpu_seconds() - cpu0;
@@ -124,6 +125,7 @@ void refuse_if_too_large(const json& r, int n, int m, int first_integrals) {
 }  // namespace
 
 std::vector<std::string> system_names() { return registered_system_names(); }
+std::vector<std::string> registered_method_names() { return method_names(); }
 
 json catalog() {
   json out;
@@ -156,6 +158,7 @@ json catalog() {
          {"discretization",
           method_flags(m.spec.kind).uses_discretization ? json(m.spec.discretization) : json(nullptr)},
          {"alpha", method_flags(m.spec.kind).uses_discretization ? json(m.spec.alpha) : json(nullptr)},
+         {"stages", m.spec.kind == SparkMethod::name ? json(m.spec.stages) : json(nullptr)},
          {"composition", m.spec.composition},
          {"order", t.order},
          {"symmetric", t.symmetric},
@@ -245,6 +248,7 @@ json validate_scene(const json& scene) {
   const double alpha = scene.contains("alpha") ? finite_number(scene["alpha"], "alpha") : 0.5;
   if (!(alpha >= 0.0 && alpha <= 1.0)) fail("alpha", "must be in [0, 1], got " + show(scene["alpha"]));
   r["alpha"] = alpha;
+  r["stages"] = scene.contains("stages") ? integer(scene["stages"], "stages", 2, 4) : 2L;
   r["start"] = scene.contains("start") ? one_of(scene["start"], "start", {"predictor", "continuation"}) : "predictor";
   r["composition"] =
       scene.contains("composition") ? one_of(scene["composition"], "composition", composition_names()) : "none";
@@ -253,9 +257,10 @@ json validate_scene(const json& scene) {
     spec.kind = r["method"];
     spec.discretization = r["discretization"];
     spec.alpha = alpha;
+    spec.stages = static_cast<int>(r["stages"].get<long>());
     if (!method_is_symmetric(spec))
       fail("composition", "\"" + r["composition"].get<std::string>() +
-                              "\" composes only symmetric methods (mp06, discrete_gradient, dla with alpha = 0.5 "
+                              "\" composes only symmetric methods (mp06, discrete_gradient, spark, dla with alpha = 0.5 "
                               "or discretization \"symmetric\"), not " +
                               spec.label());
   }

@@ -15,6 +15,7 @@
 #include "nhi/mp06_body.hpp"
 #include "nhi/reference_body.hpp"
 #include "nhi/run.hpp"
+#include "nhi/spark_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 #ifndef NHI_SYSTEM_SLOT
