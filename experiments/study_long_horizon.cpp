@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1000L, kSteps));
   study::parse(app, argc, argv);
   const nhi::FateLevels levels;
-  const std::vector<nhi::StudyMethod> methods = study::methods([](const nhi::StudyMethod& m) { return !m.external; });
+  const std::vector<nhi::StudyMethod> methods = study::methods([](const nhi::StudyMethod& m) { return !m.external && m.group != "costly"; });
   json result = {{"study", "long_horizon"},
                  {"config",
                   {{"h", "per scene: the scene file's h"},

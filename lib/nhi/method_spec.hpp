@@ -32,7 +32,8 @@ struct MethodSpec {
 };
 
 // A method's entry in the studies: "main" methods are in every study;
-// "variant"s (the paper's other alphas, ...) in those that sweep them.
+// "variant"s (the paper's other alphas, ...) in those that sweep them;
+// "costly" ones only in the studies of short runs (methods.hpp, study_methods()).
 struct StudyEntry {
   MethodSpec spec;
   std::string group = "main";

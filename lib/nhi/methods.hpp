@@ -199,17 +199,19 @@ auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
 }
 
 // The methods the studies run, in a fixed order: every method's "main"
-// study_entries() in the order of `Methods`, then every "variant", then the
-// external ones.  A method's style (colour and point type) in every figure is
+// study_entries() in the order of `Methods`, then every "variant", every
+// "costly" one, then the external ones.  A method's style (colour and point type) in every figure is
 // keyed by its label in plots/style.gp.  "main" methods are in every
 // study; "variant"s (the paper's other alphas, the costlier compositions) in
-// those that sweep them.  Entries with external = true are not library methods
+// those that sweep them; "costly" ones (a step of tens of RK4 steps: SPARK's
+// dense solve) in the studies of short runs only (convergence, stability,
+// geometry, bench_steps), not in the long-horizon, timed and many-state ones.  Entries with external = true are not library methods
 // (Boost.Odeint's adaptive pairs, run by the work-precision study only; their
 // spec names a kind no method has, so it cannot be run by mistake); they are
 // listed here so that their labels are fixed in the same place.
 struct StudyMethod {
   MethodSpec spec;
-  std::string group;  // "main" or "variant"
+  std::string group;  // "main", "variant" or "costly"
   bool external = false;
   std::string external_label;
   std::string label() const { return external ? external_label : spec.label(); }
@@ -220,7 +222,7 @@ struct StudyMethod {
 inline const std::vector<StudyMethod>& study_methods() {
   static const std::vector<StudyMethod> list = [] {
     std::vector<StudyMethod> out;
-    for (const char* group : {"main", "variant"})
+    for (const char* group : {"main", "variant", "costly"})
       for_each_type(Methods{}, [&](auto tag) {
         for (const StudyEntry& e : decltype(tag)::type::study_entries())
           if (e.group == group) out.push_back({e.spec, e.group, false, ""});

@@ -19,8 +19,7 @@ void SparkStepper<S, s>::start(const VecN& q0, const VecN& v0) {
 }
 
 template <class S, int s>
-StepSummary SparkStepper<S, s>::map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1,
-                                    VecML* lambda) const {
+StepSummary SparkStepper<S, s>::map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecML* lambda) const {
   const Problem prob(sys_, h, q0, p0);
   // Newton starts from the explicit step with the last step's multipliers.
   Vec<double, Problem::ny> y = prob.guess(*lambda);

@@ -20,8 +20,8 @@ namespace {
 
 using namespace scene_detail;
 
-const std::vector<std::string> kKeys = {"system",         "params",      "q0",   "v0",    "method",
-                                        "discretization", "alpha",       "h",    "steps", "tolerance",
+const std::vector<std::string> kKeys = {"system",         "params",      "q0",    "v0",    "method",
+                                        "discretization", "alpha",       "h",     "steps", "tolerance",
                                         "output_every",   "composition", "start", "stages"};
 
 long peak_rss_kb() {
@@ -259,10 +259,11 @@ json validate_scene(const json& scene) {
     spec.alpha = alpha;
     spec.stages = static_cast<int>(r["stages"].get<long>());
     if (!method_is_symmetric(spec))
-      fail("composition", "\"" + r["composition"].get<std::string>() +
-                              "\" composes only symmetric methods (mp06, discrete_gradient, spark, dla with alpha = 0.5 "
-                              "or discretization \"symmetric\"), not " +
-                              spec.label());
+      fail("composition",
+           "\"" + r["composition"].get<std::string>() +
+               "\" composes only symmetric methods (mp06, discrete_gradient, spark, dla with alpha = 0.5 "
+               "or discretization \"symmetric\"), not " +
+               spec.label());
   }
   const double h = finite_number(scene["h"], "h");
   if (!(h > 0)) fail("h", "must be > 0, got " + show(scene["h"]));
