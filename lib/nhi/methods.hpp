@@ -203,7 +203,7 @@ auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
 // "costly" one, then the external ones.  A method's style (colour and point type) in every figure is
 // keyed by its label in plots/style.gp.  "main" methods are in every
 // study; "variant"s (the paper's other alphas, the costlier compositions) in
-// those that sweep them; "costly" ones (a step of tens of RK4 steps: SPARK's
+// those that sweep them; "costly" ones (a step of 25 to 1000 RK4 steps: SPARK's
 // dense solve) in the studies of short runs only (convergence, stability,
 // geometry, bench_steps), not in the long-horizon, timed and many-state ones.  Entries with external = true are not library methods
 // (Boost.Odeint's adaptive pairs, run by the work-precision study only; their

@@ -279,7 +279,7 @@ struct SparkMethod {
   static constexpr bool uses_discretization = false;
   static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
   static constexpr bool reports_p = true;
-  static constexpr double step_cost = 150.0;  // 75 (s = 2) to 360 (s = 4) RK4 steps
+  static constexpr double step_cost = 250.0;  // 25 (s = 2) to 1040 (s = 4) RK4 steps
   static std::string label(const MethodSpec& spec) { return std::string(name) + " s=" + std::to_string(spec.stages); }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
@@ -295,7 +295,7 @@ struct SparkMethod {
       sp.stages = st;
       return StudyEntry{sp, group};
     };
-    // Newton on all 2ns + ms unknowns at once costs 75-360 RK4 steps a step
+    // Newton on all 2ns + ms unknowns at once costs 25-1040 RK4 steps a step
     // (results/step_costs.json): the short-run studies only (methods.hpp).
     return {spark(2, "costly"), spark(3, "costly"), spark(4, "costly")};
   }
