@@ -73,7 +73,7 @@ class Cluster : public ::testing::Test {
   fs::path dir_;
 };
 
-const std::string kStability = std::string(NHI_STABILITY) + " --only particle,contact_oscillator --T 20";
+const std::string kStability = std::string(NHI_STABILITY) + " --only particle,contact_oscillator --T 10 --roots-from 1";
 const std::string kFateMap = std::string(NHI_FATE_MAP) + " --states 3 --per-decade 4 --values 0.3,3 --T 20";
 
 TEST_F(Cluster, RanksGiveTheSingleProcessResult) {
