@@ -20,7 +20,7 @@
 // P_1..P_s, p1, Lambda_1..Lambda_s), 2ns + ms of them, solved by Newton on
 // the whole system (NewtonSolver with nl = 0).  Of order 2s - 2 in (q, p),
 // symmetric and, on a reversible system, rho-reversible for consistent starts
-// (odelab's tests; checked in tests/test_spark.cpp).  The multiplier
+// (asserted for every scene by the typed contract suite, tests/test_methods.cpp).  The multiplier
 // reported is Lambda_s, which is only O(h^(s-1)) close to lambda(t1).
 // s = 2 is a kick-drift-kick RATTLE-type method (P_1 = P_2), the counterpart
 // of mp06's drift-kick-drift (mp06.hpp): a different map of the same order.
