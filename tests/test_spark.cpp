@@ -117,6 +117,44 @@ TEST(Spark, RollingDiskStepIsOdelabs) {
                  tol);
 }
 
+// The stage-wise Jacobian (SparkProblem::jacobian) against the Jet pass over
+// all of y that NewtonSolver uses for a problem without one: the same sums
+// term by term, so the same bits.  At a point off the solution (the start
+// plus a perturbation of every unknown), on a system whose omega depends on q
+// (the rolling disk) and one whose V does (the magnetic particle).
+template <int s, class S>
+void expect_jacobian_is_the_jet_pass(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0) {
+  using P = SparkProblem<S, s>;
+  const P prob(sys, 0.3, q0, momentum(sys, q0, v0));
+  Vec<double, P::ny> y = prob.guess(Vec<double, S::m * s>::Constant(0.2));
+  for (int i = 0; i < P::ny; ++i) y[i] += 0.01 * std::sin(1.0 + i);
+  const Vec<double, 0> none;
+  Mat<double, P::ny, P::ny> Jy;
+  prob.jacobian(y, none, &Jy);
+  using J = ceres::Jet<double, P::ny>;
+  Vec<J, P::ny> yj;
+  for (int i = 0; i < P::ny; ++i) yj[i] = J(y[i], i);
+  Vec<J, P::ny> rj;
+  prob.template residual<J>(yj, Vec<J, 0>(), &rj, nullptr);
+  int nonzero = 0;
+  for (int i = 0; i < P::ny; ++i)
+    for (int j = 0; j < P::ny; ++j) {
+      EXPECT_EQ(Jy(i, j), rj[i].v[j]) << "s = " << s << ", row " << i << ", column " << j;
+      nonzero += Jy(i, j) != 0;
+    }
+  EXPECT_GT(nonzero, 2 * P::ny);  // more than the identity blocks
+}
+
+TEST(Spark, StageWiseJacobianIsTheJetPassBitForBit) {
+  const RollingDisk disk;
+  expect_jacobian_is_the_jet_pass<2>(disk, Vec<double, 4>(0.1, -0.2, 0.3, 0.4), Vec<double, 4>(1.0, 0.0, 1.0, 2.0));
+  expect_jacobian_is_the_jet_pass<4>(disk, Vec<double, 4>(0.1, -0.2, 0.3, 0.4), Vec<double, 4>(1.0, 0.0, 1.0, 2.0));
+  const MagneticParticle mag;
+  Vec<double, 3> q0, v0;
+  scene_state<MagneticParticle>(&q0, &v0);
+  expect_jacobian_is_the_jet_pass<3>(mag, q0, v0);
+}
+
 // On a separable system V(q, p) = M^-1 p does not depend on q, so both
 // stages of s = 2 have the velocity (q1 - q0)/h, the averaged constraint
 // G_1 + G_2 = 0 is (omega(q0) + omega(q1)) (q1 - q0)/h = 0, the symmetric

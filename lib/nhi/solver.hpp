@@ -16,7 +16,12 @@
 //                                    Vec<T,ny+nl>* r, Vec<double,ny+nl>* terms) const;
 //   Vec<double, ny> y_scale(const Vec<double, ny>& y) const;
 // residual() is called with T = double and T = ceres::Jet<double, ny> (y seeded,
-// lambda constant) and, in the fallback, Jets over all ny + nl unknowns; `terms`
+// lambda constant) and, in the fallback, Jets over all ny + nl unknowns.  A
+// Problem with many unknowns whose residual couples them through small blocks
+// (SPARK's stages, spark.hpp) may instead provide
+//   void jacobian(const Vec<double,ny>& y, const Vec<double,nl>& lambda, Mat<double,ny+nl,ny>* Jy) const;
+// the residual's y-Jacobian (its lambda-Jacobian is (-Wt; 0) by the form
+// above); residual() is then only called with T = double.  `terms`
 // (may be null) gets per row the sum of magnitudes of what r_i adds up.  The
 // relative residual of row i is |r_i| / (terms_i + sum_j |dr_i/dy_j| y_scale_j):
 // the second part is the residual a unit relative change of y causes, so the
@@ -79,6 +84,14 @@ struct has_continuation<P,
                                     decltype(std::declval<const P&>().small_step_start(
                                         0.0, std::declval<Vec<double, P::ny>*>(), std::declval<Vec<double, P::nl>*>())),
                                     decltype(std::declval<const P&>().h)>> : std::true_type {};
+
+// Does the Problem provide its own y-Jacobian (above)?
+template <class P, class = void>
+struct has_jacobian : std::false_type {};
+template <class P>
+struct has_jacobian<P, std::void_t<decltype(std::declval<const P&>().jacobian(
+                           std::declval<const Vec<double, P::ny>&>(), std::declval<const Vec<double, P::nl>&>(),
+                           std::declval<Mat<double, P::ny + P::nl, P::ny>*>()))>> : std::true_type {};
 
 template <class P, class = void>
 struct has_rounding_terms : std::false_type {};
@@ -310,13 +323,22 @@ class NewtonSolver {
   // (has_rounding_terms) when with_rounding.
   double evaluate(const VecY& y, const VecL& lambda, VecX* r, Mat<double, N, ny>* Jy, VecX* scale_out = nullptr,
                   bool with_rounding = false) const {
-    using J = ceres::Jet<double, ny>;
-    Vec<J, ny> yj;
-    for (int i = 0; i < ny; ++i) yj[i] = J(y[i], i);
-    const Vec<J, nl> lj = lambda.template cast<J>();
-    Vec<J, N> rj;
     VecX terms;
-    p_.template residual<J>(yj, lj, &rj, &terms);
+    if constexpr (has_jacobian<P>::value) {
+      p_.template residual<double>(y, lambda, r, &terms);
+      p_.jacobian(y, lambda, Jy);
+    } else {
+      using J = ceres::Jet<double, ny>;
+      Vec<J, ny> yj;
+      for (int i = 0; i < ny; ++i) yj[i] = J(y[i], i);
+      const Vec<J, nl> lj = lambda.template cast<J>();
+      Vec<J, N> rj;
+      p_.template residual<J>(yj, lj, &rj, &terms);
+      for (int i = 0; i < N; ++i) {
+        (*r)[i] = rj[i].a;
+        for (int j = 0; j < ny; ++j) (*Jy)(i, j) = rj[i].v[j];
+      }
+    }
     const VecY ys = p_.y_scale(y);
     if constexpr (has_rounding_terms<P>::value) {
       if (with_rounding) {
@@ -327,12 +349,8 @@ class NewtonSolver {
     }
     double rel = 0;
     for (int i = 0; i < N; ++i) {
-      (*r)[i] = rj[i].a;
       double scale = terms[i];
-      for (int j = 0; j < ny; ++j) {
-        (*Jy)(i, j) = rj[i].v[j];
-        scale += std::abs(rj[i].v[j]) * ys[j];
-      }
+      for (int j = 0; j < ny; ++j) scale += std::abs((*Jy)(i, j)) * ys[j];
       if (scale_out) (*scale_out)[i] = scale;
       rel = std::max(rel, ratio((*r)[i], scale));
     }
@@ -597,11 +615,49 @@ class NewtonSolver {
     }
   };
 
+  // The same with the Problem's own Jacobian (has_jacobian), column-major.
+  struct JacobianFunctor {
+    using Scalar = double;
+    enum { NUM_RESIDUALS = N, NUM_PARAMETERS = N };
+    const P* problem;
+    bool operator()(const double* x, double* residuals, double* jacobian) const {
+      const VecY y = Eigen::Map<const VecY>(x);
+      const VecL lambda = Eigen::Map<const VecL>(x + ny);
+      VecX r;
+      problem->template residual<double>(y, lambda, &r, nullptr);
+      Eigen::Map<VecX> res(residuals);
+      res = r;
+      if (jacobian) {
+        Eigen::Map<Mat<double, N, N>> J(jacobian);
+        Mat<double, N, ny> Jy;
+        problem->jacobian(y, lambda, &Jy);
+        J.template leftCols<ny>() = Jy;
+        if constexpr (nl > 0) {
+          J.template topRightCorner<ny, nl>() = -problem->Wt();
+          J.template bottomRightCorner<nl, nl>().setZero();
+        }
+      }
+      return true;
+    }
+  };
+
   Summary tiny_solver(VecY* y_io, VecL* lambda_io) const {
+    if constexpr (has_jacobian<P>::value) {
+      JacobianFunctor f{&p_};
+      ceres::TinySolver<JacobianFunctor> solver;
+      return tiny_solve(f, &solver, y_io, lambda_io);
+    } else {
+      Functor f{&p_};
+      ceres::TinySolverAutoDiffFunction<Functor, N, N> cost(f);  // keeps a reference to f
+      ceres::TinySolver<ceres::TinySolverAutoDiffFunction<Functor, N, N>> solver;
+      return tiny_solve(cost, &solver, y_io, lambda_io);
+    }
+  }
+
+  template <class Cost, class Solver>
+  Summary tiny_solve(const Cost& cost, Solver* solver_ptr, VecY* y_io, VecL* lambda_io) const {
     Summary s;
-    Functor f{&p_};
-    ceres::TinySolverAutoDiffFunction<Functor, N, N> cost(f);  // keeps a reference to f
-    ceres::TinySolver<ceres::TinySolverAutoDiffFunction<Functor, N, N>> solver;
+    Solver& solver = *solver_ptr;
     solver.options.max_num_iterations = 200;
     solver.options.gradient_tolerance = 0;
     solver.options.parameter_tolerance = 1e-15;  // relative step below round-off: stop

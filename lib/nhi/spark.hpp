@@ -34,6 +34,7 @@
 #include "nhi/composition.hpp"
 #include "nhi/hamiltonian.hpp"
 #include "nhi/method_spec.hpp"
+#include "nhi/mp06.hpp"
 #include "nhi/solver.hpp"
 
 namespace nhi {
@@ -193,16 +194,85 @@ struct SparkProblem {
     const Vec<T, n> q1 = stage_q(y, s - 1), p1 = y.template segment<n>(kP1);
     const Vec<T, n> v1 = velocity(sys, q1, p1);
     const Mat<T, m, n> W1 = sys.template omega<T>(q1);
-    for (int a = 0; a < m; ++a) {
-      T g = cst<T>(0.0);
-      double sz = 0;
+    mp06_constraint_rows(W1, v1, kL + m * (s - 1), r, terms);
+  }
+
+  // The residual's y-Jacobian, assembled from each stage's derivatives in its
+  // own 2n + m unknowns (Q_j, P_j, Lambda_j): Jets of that width instead of
+  // ny = 2ns + ms (NewtonSolver's has_jacobian).  Every entry is the sum the
+  // Jet pass over all of y forms, term by term in the same order, so the two
+  // agree to the last bit (tests/test_spark.cpp compares them).
+  void jacobian(const Vec<double, ny>& y, const Vec<double, nl>&, Mat<double, ny, ny>* Jy) const {
+    constexpr int nz = 2 * n + m;
+    using J = ceres::Jet<double, nz>;
+    using Dn = Mat<double, n, ny>;
+    const Tab& tb = Tab::get();
+    // Stage j's V, F + omega^T Lambda and G, and the end point's G(q1, p1),
+    // differentiated in y: rows of width ny, zero outside the stage's columns.
+    std::array<Dn, s> dV, dF;
+    std::array<Mat<double, m, ny>, s + 1> dG;
+    for (int j = 0; j <= s; ++j) {
+      const bool end = j == s;  // (q1, p1) = (Q_s, y[kP1]), no multiplier
+      const int jq = end ? s - 1 : j;
+      // the columns of (Q, P, Lambda) in y; -1: a constant (Q_1 = q0; the end's Lambda)
+      std::array<int, nz> col;
       for (int k = 0; k < n; ++k) {
-        g += W1(a, k) * v1[k];
-        sz += std::abs(value_of(W1(a, k)) * value_of(v1[k]));
+        col[k] = jq == 0 ? -1 : kQ + n * (jq - 1) + k;
+        col[n + k] = (end ? kP1 : kP + n * j) + k;
       }
-      (*r)[kL + m * (s - 1) + a] = g;
-      if (terms) (*terms)[kL + m * (s - 1) + a] = sz;
+      for (int a = 0; a < m; ++a) col[2 * n + a] = end ? -1 : kL + m * j + a;
+      Vec<J, n> Q, P;
+      Vec<J, m> L;
+      for (int k = 0; k < n; ++k) {
+        Q[k] = J(jq == 0 ? q0[k] : y[col[k]], k);
+        P[k] = J(y[col[n + k]], n + k);
+      }
+      for (int a = 0; a < m; ++a) L[a] = J(end ? 0.0 : y[col[2 * n + a]], 2 * n + a);
+      const Vec<J, n> V = velocity(sys, Q, P);
+      const Mat<J, m, n> W = sys.template omega<J>(Q);
+      Vec<J, m> G;
+      if (end) {  // row (6)'s sum, as residual() forms it
+        Vec<J, m> r6;
+        mp06_constraint_rows<J, m, n, m>(W, V, 0, &r6, nullptr);
+        G = r6;
+      } else {
+        G = W * V;
+      }
+      auto spread = [&](const auto& f, auto* d) {
+        d->setZero();
+        for (int r = 0; r < f.size(); ++r)
+          for (int c = 0; c < nz; ++c)
+            if (col[c] >= 0) (*d)(r, col[c]) = f[r].v[c];
+      };
+      spread(G, &dG[j]);
+      if (end) continue;
+      Vec<J, n> F, dv;
+      lagrangian_partials(sys, Q, V, &F, &dv);
+      const Vec<J, n> Fs = F + W.transpose() * L;
+      spread(V, &dV[j]);
+      spread(Fs, &dF[j]);
     }
+    Jy->setZero();
+    // (1): Q_i - q0 - h sum_j a_ij V_j, i = 2..s
+    for (int i = 1; i < s; ++i) {
+      Dn acc = Dn::Zero();
+      for (int j = 0; j < s; ++j) acc += tb.a[i][j] * dV[j];
+      Dn row = -h * acc;
+      for (int k = 0; k < n; ++k) row(k, kQ + n * (i - 1) + k) = 1.0 - h * acc(k, kQ + n * (i - 1) + k);
+      Jy->template block<n, ny>(kQ + n * (i - 1), 0) = row;
+    }
+    // (2) and (4): P_i - p0 - h sum_j ahat_ij (F + omega^T Lambda)_j
+    for (int i = 0; i <= s; ++i) {
+      Dn acc = Dn::Zero();
+      for (int j = 0; j < s; ++j) acc += (i < s ? tb.ahat[i][j] : tb.b[j]) * dF[j];
+      Dn row = -h * acc;
+      for (int k = 0; k < n; ++k) row(k, kP + n * i + k) = 1.0 - h * acc(k, kP + n * i + k);
+      Jy->template block<n, ny>(kP + n * i, 0) = row;
+    }
+    // (5): G_j - pi_j G_s
+    for (int j = 0; j < s - 1; ++j) Jy->template block<m, ny>(kL + m * j, 0) = dG[j] - tb.pi[j] * dG[s - 1];
+    // (6): G(q1, p1)
+    Jy->template block<m, ny>(kL + m * (s - 1), 0) = dG[s];
   }
 
   // A first-order start: stage i at c_i h along the explicit step with the
