@@ -3,7 +3,7 @@
 // (b) max |E - E0| over T = 10^4 (and over its first 100 time units) against CPU time;
 // for the "main" fixed-step methods of nhi::study_methods() (DLA alpha = 1/2,
 // symmetric alpha = 0, RK4, mp06, the discrete gradient and their compositions)
-// over h = 0.4 / 2^j, and for adaptive methods over
+// and SPARK of orders 4 and 6 over h = 0.4 / 2^j, and for adaptive methods over
 // tolerances: CVODE Adams (the reference solution) and the
 // explicit embedded Runge-Kutta pairs a C++ user would reach for, Boost.Odeint's
 // runge_kutta_fehlberg78 and runge_kutta_dopri5 (controlled, atol = rtol = tol),
@@ -55,6 +55,11 @@ constexpr double kSelfTimed = 0.5;  // s (see cpu_energy below)
 // CPU time (a second-order method's run at h = 0.4/2^9 over T = 10^4 is
 // 1.3e7 steps).  Order 6 reaches the round-off floor by j = 5.
 constexpr int kFinestJ = 5;
+// SPARK with 3 and 4 stages ("costly", orders 4 and 6), for its cost at
+// orders 4 and 6 against mp06's compositions: h = 0.4 / 2^j to j = 3 and no
+// 10^6 run (its step costs 20-560 RK4 steps; the rows follow the others').
+constexpr int kFinestJCostly = 3;
+constexpr int kCostlyMinStages = 3;
 constexpr int kLoosestTol = 3, kTightestTolReference = 12, kTightestTolPairs = 13;
 volatile double g_sink = 0;  // keeps timed runs from being optimized away
 
@@ -105,6 +110,7 @@ template <class S>
 bool long_run(const S& sys, const Config& c) {
   if (c.method.external) return c.method.external_label != "dopri5" || c.param >= kTightestTolLongDopri5 * (1 - 1e-9);
   if (c.method.spec.kind == "benchmark") return false;  // CVODE: many times rkf78's cost per step here
+  if (c.method.group == "costly") return false;
   const nhi::MethodTraits t = nhi::method_traits(sys, c.method.spec);
   return t.preserves_energy ? c.param >= 0.4 * (1 - 1e-12) : c.param >= 0.1 * (1 - 1e-12);
 }
@@ -189,6 +195,9 @@ int main(int argc, char** argv) {
   const auto reference =
       study::methods([](const nhi::StudyMethod& m) { return m.spec.kind == "benchmark" && !m.external; });
   const auto external = study::methods([](const nhi::StudyMethod& m) { return m.external; });
+  const auto costly = study::methods([](const nhi::StudyMethod& m) {
+    return study::fixed_step(m) && m.group == "costly" && m.spec.stages >= kCostlyMinStages;
+  });
   // Every fixed-step method over the same h (see kFinestJ).
   auto configs_for = [&](const auto&) {
     std::vector<Config> configs;
@@ -198,6 +207,8 @@ int main(int argc, char** argv) {
       for (const auto& m : reference) configs.push_back({m, std::pow(10.0, -e)});
     for (int e = kLoosestTol; e <= kTightestTolPairs; ++e)
       for (const auto& m : external) configs.push_back({m, std::pow(10.0, -e)});
+    for (int j = 0; j <= kFinestJCostly; ++j)
+      for (const auto& m : costly) configs.push_back({m, 0.4 / (1 << j)});
     return configs;
   };
   json result = {{"study", "work_precision"},
@@ -206,7 +217,9 @@ int main(int argc, char** argv) {
                    {"T_energy", kT_energy},
                    {"T_energy_short", kT_energy_short},
                    {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
-                   {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods)"},
+                   {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods), j = 0 ... " +
+                                   std::to_string(kFinestJCostly) + " (SPARK, stages >= " +
+                                   std::to_string(kCostlyMinStages) + ", no T_long run)"},
                    {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
                                       tol_range(kTightestTolPairs) + " (the explicit pairs)"},
                    {"cpu",

@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "nhi/systems/robot_extrinsic.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {
@@ -68,6 +69,63 @@ TYPED_TEST(SolverTest, NewtonStartAtRoundOffTakesItsUpdate) {
     worst_rel = std::max(worst_rel, rel);
   }
   std::printf("[ %s ] start at 8 eps: residual after its update / the start's <= %.2g\n", S::name, worst_rel);
+}
+
+// The fallback's Jacobian in all N = ny + nl unknowns (FallbackCost: the
+// y-columns from Newton's Jet pass, the multiplier columns (-Wt; 0) by the
+// saddle-point form) is the Jacobian of Jets over all N unknowns, bit for bit,
+// for the problems with multipliers apart from y: the DLA step (eq. 6, with
+// the holonomic rows on the robot's extrinsic form) and mp06's velocity form.
+template <class P>
+void expect_fallback_jacobian_is_the_jet_pass(const P& prob, const Vec<double, P::ny>& y,
+                                              const Vec<double, P::nl>& lambda) {
+  constexpr int ny = P::ny, nl = P::nl, N = ny + nl;
+  const NewtonSolver<P> solver(prob);
+  Vec<double, N> x, r;
+  x << y, lambda;
+  Mat<double, N, N> J;
+  ASSERT_TRUE(typename NewtonSolver<P>::FallbackCost{&solver}(x.data(), r.data(), J.data()));
+  using Jt = ceres::Jet<double, N>;
+  Vec<Jt, ny> yj;
+  Vec<Jt, nl> lj;
+  for (int i = 0; i < ny; ++i) yj[i] = Jt(y[i], i);
+  for (int a = 0; a < nl; ++a) lj[a] = Jt(lambda[a], ny + a);
+  Vec<Jt, N> rj;
+  prob.template residual<Jt>(yj, lj, &rj, nullptr);
+  for (int i = 0; i < N; ++i) {
+    EXPECT_EQ(r[i], rj[i].a) << "row " << i;
+    for (int j = 0; j < N; ++j) EXPECT_EQ(J(i, j), rj[i].v[j]) << "row " << i << ", column " << j;
+  }
+}
+
+template <class S>
+void expect_fallback_jacobians(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double h,
+                               bool mp06) {
+  const Vec<double, S::n> p0 = momentum(sys, q0, v0);
+  const Vec<double, S::n> q1 = q0 + h * v0 + Vec<double, S::n>::Constant(1e-3);
+  const AlphaDiscretization disc{0.5};
+  using D = DlaStepProblem<S, AlphaDiscretization>;
+  const D dla(sys, disc, h, q0, p0);
+  expect_fallback_jacobian_is_the_jet_pass(dla, q1, Vec<double, D::nl>::Constant(0.1));
+  if constexpr (S::m > 0) {
+    if (!mp06) return;
+    using M = Mp06Problem<S>;
+    const M mp(sys, h, q0, p0);
+    expect_fallback_jacobian_is_the_jet_pass(mp, Vec<double, S::n>(v0 + Vec<double, S::n>::Constant(0.01)),
+                                             Vec<double, M::nl>::Constant(0.1));
+  }
+}
+
+TEST(Solver, FallbackJacobianIsTheJetPassOverAllUnknowns) {
+  Vec<double, 3> q, v;
+  scene_state<Particle>(&q, &v);
+  expect_fallback_jacobians(Particle(), q, v, 0.2, true);
+  Vec<double, 4> qr, vr;
+  scene_state<Robot>(&qr, &vr);
+  expect_fallback_jacobians(Robot(), qr, vr, 0.2, true);
+  // with the holonomic rows of eq. 17 among the multipliers
+  expect_fallback_jacobians(RobotExtrinsic(), RobotExtrinsic::embed(qr), RobotExtrinsic::embed_velocity(qr, vr), 0.2,
+                            false);
 }
 
 // The shared failure path: a solve that cannot reach its tolerance and a

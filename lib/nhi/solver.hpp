@@ -16,7 +16,7 @@
 //                                    Vec<T,ny+nl>* r, Vec<double,ny+nl>* terms) const;
 //   Vec<double, ny> y_scale(const Vec<double, ny>& y) const;
 // residual() is called with T = double and T = ceres::Jet<double, ny> (y seeded,
-// lambda constant) and, in the fallback, Jets over all ny + nl unknowns.  A
+// lambda constant; the fallback's lambda-columns are (-Wt; 0), by the form).  A
 // Problem with many unknowns whose residual couples them through small blocks
 // (SPARK's stages, spark.hpp) may instead provide
 //   void jacobian(const Vec<double,ny>& y, const Vec<double,nl>& lambda, Mat<double,ny+nl,ny>* Jy) const;
@@ -59,7 +59,6 @@
 #pragma once
 
 #include <ceres/tiny_solver.h>
-#include <ceres/tiny_solver_autodiff_function.h>
 
 #include <Eigen/LU>
 #include <algorithm>
@@ -598,60 +597,46 @@ class NewtonSolver {
     return s;
   }
 
-  // The same residual for ceres::TinySolverAutoDiffFunction (all N unknowns).
-  struct Functor {
-    enum { NUM_RESIDUALS = N, NUM_PARAMETERS = N };
-    const P* problem;
-    template <class T>
-    bool operator()(const T* x, T* residuals) const {
-      Vec<T, ny> y;
-      Vec<T, nl> lambda;
-      for (int i = 0; i < ny; ++i) y[i] = x[i];
-      for (int a = 0; a < nl; ++a) lambda[a] = x[ny + a];
-      Vec<T, N> r;
-      problem->template residual<T>(y, lambda, &r, nullptr);
-      for (int i = 0; i < N; ++i) residuals[i] = r[i];
-      return true;
-    }
-  };
-
-  // The same with the Problem's own Jacobian (has_jacobian), column-major.
-  struct JacobianFunctor {
+ public:
+  // The residual and its Jacobian in all N unknowns for ceres::TinySolver,
+  // column-major: the y-columns from evaluate() (the Problem's own Jacobian
+  // or the Jet pass Newton uses), the lambda-columns (-Wt; 0) by the
+  // saddle-point form (top of this file).  The same numbers as Jets over all
+  // N unknowns (ceres::TinySolverAutoDiffFunction) would give, derivative by
+  // derivative, without compiling the residual for a second Jet width.
+  struct FallbackCost {
     using Scalar = double;
     enum { NUM_RESIDUALS = N, NUM_PARAMETERS = N };
-    const P* problem;
+    const NewtonSolver* solver;
     bool operator()(const double* x, double* residuals, double* jacobian) const {
       const VecY y = Eigen::Map<const VecY>(x);
       const VecL lambda = Eigen::Map<const VecL>(x + ny);
-      VecX r;
-      problem->template residual<double>(y, lambda, &r, nullptr);
       Eigen::Map<VecX> res(residuals);
+      if (!jacobian) {
+        VecX r;
+        solver->p_.template residual<double>(y, lambda, &r, nullptr);
+        res = r;
+        return true;
+      }
+      VecX r;
+      Mat<double, N, ny> Jy;
+      solver->evaluate(y, lambda, &r, &Jy);
       res = r;
-      if (jacobian) {
-        Eigen::Map<Mat<double, N, N>> J(jacobian);
-        Mat<double, N, ny> Jy;
-        problem->jacobian(y, lambda, &Jy);
-        J.template leftCols<ny>() = Jy;
-        if constexpr (nl > 0) {
-          J.template topRightCorner<ny, nl>() = -problem->Wt();
-          J.template bottomRightCorner<nl, nl>().setZero();
-        }
+      Eigen::Map<Mat<double, N, N>> J(jacobian);
+      J.template leftCols<ny>() = Jy;
+      if constexpr (nl > 0) {
+        J.template topRightCorner<ny, nl>() = -solver->p_.Wt();
+        J.template bottomRightCorner<nl, nl>().setZero();
       }
       return true;
     }
   };
 
+ private:
   Summary tiny_solver(VecY* y_io, VecL* lambda_io) const {
-    if constexpr (has_jacobian<P>::value) {
-      JacobianFunctor f{&p_};
-      ceres::TinySolver<JacobianFunctor> solver;
-      return tiny_solve(f, &solver, y_io, lambda_io);
-    } else {
-      Functor f{&p_};
-      ceres::TinySolverAutoDiffFunction<Functor, N, N> cost(f);  // keeps a reference to f
-      ceres::TinySolver<ceres::TinySolverAutoDiffFunction<Functor, N, N>> solver;
-      return tiny_solve(cost, &solver, y_io, lambda_io);
-    }
+    const FallbackCost cost{this};
+    ceres::TinySolver<FallbackCost> solver;
+    return tiny_solve(cost, &solver, y_io, lambda_io);
   }
 
   template <class Cost, class Solver>
