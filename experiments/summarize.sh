@@ -294,6 +294,20 @@ jq -r "$G$WP$CLASSICAL"'
   if ($best | length) == 0 then "| \($s) | \($h)\($tag) | \($tol | g) | none reaches it | - | - | - | - | - |"
   else "| \($s) | \($h)\($tag) | \($tol | g) | \($best[0].label) (\($best[0].param | g)) | \($best[0].cpu | g) | \(if ($best | length) > 1 then $best[1].label else "-" end) | \(if ($best | length) > 1 then ($best[1].cpu / $best[0].cpu | g) else "-" end) | \(if $rk then $rk.label else "none" end) | \(if $rk then ($rk.cpu / $best[0].cpu | g) else "-" end) |" end' "$R/work_precision.json"
 
+# ---- SPARK against mp06's compositions (study_work_precision) ------------
+echo "## SPARK against mp06's compositions at equal error (results/work_precision.json)"
+echo
+echo "CPU time to bring max |q(T) - q_ref(T)| at T = 10 below the target, SPARK over mp06's composition of the same order (order 4: spark s=3 over mp06+triple_jump; order 6: spark s=4 over mp06+order6), each at its cheapest h; - where one of the two reaches no target on the h grid."
+echo
+echo "| scene | order 4, 1e-6 | order 6, 1e-6 | order 6, 1e-9 |"
+echo "|---|---|---|---|"
+jq -r '
+def best($r; $l; $t): [$r[] | select(.label == $l and .status == "ok" and .final_error <= $t) | .cpu_final] | min;
+def ratio($a; $b): if $a == null or $b == null then "-" else ($a / $b * 10 | round / 10 | tostring) end;
+.scenes | to_entries[] | .value.runs as $r |
+  "| \(.key) | \(ratio(best($r; "spark s=3"; 1e-6); best($r; "mp06+triple_jump"; 1e-6))) | \(ratio(best($r; "spark s=4"; 1e-6); best($r; "mp06+order6"; 1e-6))) | \(ratio(best($r; "spark s=4"; 1e-9); best($r; "mp06+order6"; 1e-9))) |"' "$R/work_precision.json"
+echo
+
 # ---- Growth of the global error (study_global_error) ------------------------
 if [ -f "$R/global_error.json" ]; then
 echo "## Growth of the global error (results/global_error.json)"
