@@ -7,7 +7,7 @@
 
 DEB_PACKAGES := cmake ninja-build g++ make libeigen3-dev libceres-dev libsundials-dev \
                 nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev libboost-dev \
-                gnuplot-nox jq libopenmpi-dev openmpi-bin clang libclang-rt-14-dev
+                gnuplot-nox jq git libopenmpi-dev openmpi-bin clang libclang-rt-14-dev
 BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2
