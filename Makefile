@@ -3,7 +3,7 @@
 #   make reproduce   regenerate the figure runs, the short studies, the summary
 #                    and every figure; check that the large tables are current
 #   make sweep       regenerate the large tables (long runs, many states, timings)
-# Both first install any missing Debian package (target deps).
+# Each first installs any missing Debian package (target deps).
 
 DEB_PACKAGES := cmake ninja-build g++ make libeigen3-dev libceres-dev libsundials-dev \
                 nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev libboost-dev \
