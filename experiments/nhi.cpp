@@ -40,6 +40,8 @@ std::string method_keys(const nhi::json& m) {
   if (!m["discretization"].is_null())
     out += ", \"discretization\": \"" + m["discretization"].get<std::string>() + "\", \"alpha\": " + num(m["alpha"]);
   if (m.contains("stages") && !m["stages"].is_null()) out += ", \"stages\": " + num(m["stages"]);
+  if (m.contains("constraint") && m["constraint"] == "endpoint")
+    out += ", \"constraint\": \"" + m["constraint"].get<std::string>() + "\"";
   if (m["composition"] != "none") out += ", \"composition\": \"" + m["composition"].get<std::string>() + "\"";
   return out;
 }

@@ -33,6 +33,10 @@ set style line 31 lc rgb "#000000" pt 2  lw 1.5
 set style line 32 lc rgb "#637939" pt 5  lw 1.5
 set style line 33 lc rgb "#8ca252" pt 7  lw 1.5
 set style line 34 lc rgb "#b5cf6b" pt 9  lw 1.5
+set style line 35 lc rgb "#843c39" pt 4  lw 1.5
+set style line 36 lc rgb "#ad494a" pt 6  lw 1.5
+set style line 37 lc rgb "#d6616b" pt 8  lw 1.5
+set style line 38 lc rgb "#e7969c" pt 10 lw 1.5
 set style line 40 lc rgb "#aaaaaa" pt 1  lw 1.0
 method_ls(label) = \
   label eq "dla a=0.5" ? 11 : \
@@ -59,6 +63,10 @@ method_ls(label) = \
   label eq "spark s=2" ? 32 : \
   label eq "spark s=3" ? 33 : \
   label eq "spark s=4" ? 34 : \
+  label eq "discrete_gradient endpoint" ? 35 : \
+  label eq "discrete_gradient endpoint+triple_jump" ? 36 : \
+  label eq "discrete_gradient endpoint+suzuki5" ? 37 : \
+  label eq "discrete_gradient endpoint+order6" ? 38 : \
   40
 # One jq pass per figure: calling jq once per label and per data series would
 # start jq and parse the result hundreds of times a figure.  A script

@@ -14,6 +14,14 @@
 
 namespace nhi::test {
 
+// Systems whose index-reduced flow is a quadrature (rolling_disk.hpp): there
+// every Runge-Kutta method is symmetric (test_methods.cpp), and omega(q) v is
+// constant along the flow.
+template <class S, class = void>
+struct is_quadrature_flow : std::false_type {};
+template <class S>
+struct is_quadrature_flow<S, std::enable_if_t<S::quadrature_flow>> : std::true_type {};
+
 // Every registered scene (systems/registry.hpp); typed tests run on each, or on
 // those that declare the capability a suite needs.
 using Systems = nhi::Systems::apply<::testing::Types>;

@@ -299,5 +299,67 @@ TEST(DiscreteGradient, DefiningIdentityOnANonQuadraticEnergy) {
   }
 }
 
+// The endpoint variant (discrete_gradient.hpp), checked against its defining
+// equations written out here, on every scene: with g = gradbar_q H,
+// u = gradbar_p H and kappa = lambda . omega(qbar) u / (|g|^2 + |u|^2),
+//     q1 - q0 = h (u - kappa g),  p1 - p0 = h (-g + omega(qbar)^T lambda - kappa u),
+//     omega(q1) V(q1, p1) = 0,
+// so that every grid point is on the constraint manifold and H(z1) = H(z0).
+// The midpoint form's grid points are off it by a measurable amount at the
+// same h (what the endpoint variant's compositions are about: README
+// "Methods"); on the rolling disk omega(q) v is constant along the flow and
+// both stay on it.
+template <class S>
+class DiscreteGradientEndpointTest : public ::testing::Test {};
+TYPED_TEST_SUITE(DiscreteGradientEndpointTest, Systems);
+
+TYPED_TEST(DiscreteGradientEndpointTest, StepSatisfiesItsDefiningEquations) {
+  using S = TypeParam;
+  constexpr int n = S::n, m = S::m;
+  const S sys = make_system<S>();
+  for (double h : {0.2, -0.1, 0.05}) {
+    DiscreteGradientStepper<S> endpoint(sys, SolverOptions{}, true), midpoint(sys);
+    ASSERT_TRUE(endpoint.traits().holds_velocity_constraint && endpoint.traits().preserves_energy);
+    endpoint.start(S::default_q0(), S::default_v0());
+    midpoint.start(S::default_q0(), S::default_v0());
+    const double H0 = hamiltonian<S, double>(sys, S::default_q0(), momentum(sys, S::default_q0(), S::default_v0()));
+    double worst_q = 0, worst_p = 0, worst_c = 0, worst_H = 0, midpoint_c = 0, scale = 0;
+    for (int k = 0; k < 60; ++k) {
+      Sample<n, m> before, after, mid;
+      endpoint.sample(&before);
+      ASSERT_TRUE(endpoint.step(h).ok()) << S::name << " h " << h << " step " << k;
+      ASSERT_TRUE(midpoint.step(h).ok()) << S::name << " h " << h << " step " << k;
+      endpoint.sample(&after);
+      midpoint.sample(&mid);
+      const DiscreteGradientProblem<S> prob(sys, h, before.q, before.p);
+      Vec<double, n> g, u;
+      prob.template discrete_gradient<double>(after.q, after.p, &g, &u);
+      const Mat<double, m, n> Wb = sys.template omega<double>(Vec<double, n>(0.5 * (before.q + after.q)));
+      const double kappa = after.lambda.dot(Wb * u) / (g.squaredNorm() + u.squaredNorm());
+      const Vec<double, n> force = Wb.transpose() * after.lambda;
+      worst_q = std::max(worst_q, (after.q - before.q - h * (u - kappa * g)).cwiseAbs().maxCoeff() /
+                                      (1 + after.q.cwiseAbs().maxCoeff()));
+      worst_p = std::max(worst_p, (after.p - before.p - h * (force - g - kappa * u)).cwiseAbs().maxCoeff() /
+                                      (1 + after.p.cwiseAbs().maxCoeff() + std::abs(h) * force.cwiseAbs().maxCoeff()));
+      worst_c = std::max(worst_c, (sys.template omega<double>(after.q) * after.v).cwiseAbs().maxCoeff() /
+                                      (1 + after.v.cwiseAbs().maxCoeff()));
+      const double E = hamiltonian<S, double>(sys, after.q, after.p), T = 0.5 * after.p.dot(after.v);
+      worst_H = std::max(worst_H, std::abs(E - H0));
+      scale = std::max(scale, std::abs(T) + std::abs(E - T));
+      midpoint_c = std::max(midpoint_c, (sys.template omega<double>(mid.q) * mid.v).cwiseAbs().maxCoeff() /
+                                            (1 + mid.v.cwiseAbs().maxCoeff()));
+    }
+    EXPECT_LE(worst_q, 64 * kEps) << S::name << " h " << h;
+    EXPECT_LE(worst_p, 64 * kEps) << S::name << " h " << h;
+    EXPECT_LE(worst_c, 64 * kEps) << S::name << " h " << h;
+    // Round-off as MethodContract.EnergyPreservingMethodsKeepItToRoundOff
+    // defines it: 4 eps of the energy's terms per step.
+    EXPECT_LE(worst_H, 60 * 4 * kEps * scale) << S::name << " h " << h;
+    if (!is_quadrature_flow<S>::value) {
+      EXPECT_GE(midpoint_c, 1e3 * std::max(worst_c, kEps)) << S::name << " h " << h;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace nhi::test

@@ -24,13 +24,6 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 // An energy error below this fraction of |E0| is round-off (FateLevels::roundoff_relative).
 constexpr double kRoundOffEnergy = 1e-10;
 
-// Systems whose index-reduced flow is a quadrature (rolling_disk.hpp): there
-// every Runge-Kutta method is symmetric, so "measurably not symmetric" is not asserted.
-template <class S, class = void>
-struct is_quadrature_flow : std::false_type {};
-template <class S>
-struct is_quadrature_flow<S, std::enable_if_t<S::quadrature_flow>> : std::true_type {};
-
 // Library methods with a fixed step (the reference solution is adaptive).
 std::vector<StudyMethod> fixed_step_methods() {
   std::vector<StudyMethod> out;

@@ -14,6 +14,26 @@
 // the averaged form of the third line.  Symmetric (exchanging z0, z1 and h -> -h
 // leaves the equations unchanged) and of order 2.
 //
+// The endpoint variant (MethodSpec::constraint = "endpoint"; ours, to test
+// why the compositions stop at order 4: README "Methods"): the same discrete
+// gradient with the constraint at the new grid point.  The constraint force
+// then does work, h lambda . omega(qbar) u with u = gradbar_p H, and a step
+// along the discrete gradient takes it back:
+//     (q1 - q0)/h =  u - kappa g,                 g = gradbar_q H
+//     (p1 - p0)/h = -g + omega(qbar)^T lambda - kappa u,
+//     omega(q1) V(q1, p1) = 0,                    kappa = lambda . omega(qbar) u / (|g|^2 + |u|^2)
+// so that H(z1) - H(z0) = h (lambda . omega(qbar) u - kappa (|g|^2 + |u|^2)) = 0
+// exactly, while every grid point lies on the constraint manifold.  On that
+// manifold omega(qbar) u = O(h^2), so the correction is O(h^3) and the step of
+// order 2; the denominator |gradbar H|^2 vanishes only at equilibria, so the
+// map is smooth at the turning points of an oscillation too (turning the force
+// instead, omega - (omega u) u^T / |u|^2, divides by |V|^2 and is not: its
+// compositions' fitted orders scatter from random states).  Symmetric on the
+// manifold as RATTLE is: the first 2n equations are invariant under
+// (z0, z1, h) -> (z1, z0, -h), and the reversed step's constraint row holds
+// at z0, which is on the manifold.  No fast passes: Newton from the explicit
+// guess on every step.
+//
 // The constraint rows omega(qbar) move with q1, so lambda is one more unknown of
 // a plain Newton solve (NewtonSolver with nl = 0, LU of the whole Jacobian).
 // On a separable system fixed-point passes come first (passes(), defined in
@@ -44,25 +64,34 @@ struct DiscreteGradientProblem {
   double h;
   VecN q0, p0;
   double H0;
+  bool endpoint = false;    // the endpoint variant (above)
   Mat<double, ny, nl> W_t;  // empty: lambda is part of y
 
-  DiscreteGradientProblem(const S& s, double hh, const VecN& q, const VecN& p)
-      : sys(s), h(hh), q0(q), p0(p), H0(hamiltonian<S, double>(s, q, p)) {}
+  DiscreteGradientProblem(const S& s, double hh, const VecN& q, const VecN& p, bool at_endpoint = false)
+      : sys(s), h(hh), q0(q), p0(p), H0(hamiltonian<S, double>(s, q, p)), endpoint(at_endpoint) {}
 
   const Mat<double, ny, nl>& Wt() const { return W_t; }
 
   // Root following (solver.hpp): the same step at h2; as h -> 0 the root
   // tends to (q0, p0) with a multiplier of the size of a force.
-  DiscreteGradientProblem at_step(double h2) const { return DiscreteGradientProblem(sys, h2, q0, p0); }
+  DiscreteGradientProblem at_step(double h2) const { return DiscreteGradientProblem(sys, h2, q0, p0, endpoint); }
   void small_step_start(double ratio, Vec<double, ny>* y, Vec<double, nl>*) const {
     y->template head<n>() = q0 + ratio * (y->template head<n>() - q0);
     y->template segment<n>(n) = p0 + ratio * (y->template segment<n>(n) - p0);
   }
 
+  // The endpoint variant's q1 by its move from q0: its constraint row reads
+  // q1 through omega(q1), whose change over one ulp of a large |q| (the robot's
+  // angles grow without bound) would otherwise set the row's floor far above
+  // what the reachable q1 gives (Newton iterates until it stops improving).
   Vec<double, ny> y_scale(const Vec<double, ny>& y) const {
     Vec<double, ny> s;
-    s << q0.cwiseAbs() + y.template head<n>().cwiseAbs(), p0.cwiseAbs() + y.template segment<n>(n).cwiseAbs(),
-        y.template tail<m>().cwiseAbs();
+    if (endpoint)
+      s.template head<n>() = (y.template head<n>() - q0).cwiseAbs();
+    else
+      s.template head<n>() = q0.cwiseAbs() + y.template head<n>().cwiseAbs();
+    s.template segment<n>(n) = p0.cwiseAbs() + y.template segment<n>(n).cwiseAbs();
+    s.template tail<m>() = y.template tail<m>().cwiseAbs();
     return s;
   }
 
@@ -115,15 +144,42 @@ struct DiscreteGradientProblem {
     const Vec<T, n> qb = cst<T>(0.5) * (q0.template cast<T>() + q1);
     const Mat<T, m, n> Wb = sys.template omega<T>(qb);
     const Vec<T, n> fc = Wb.transpose() * lambda;
+    // The endpoint variant's correction kappa gradbar H (above; 0 otherwise).
+    Vec<T, n> kq = Vec<T, n>::Constant(cst<T>(0.0)), kp = kq;
+    double ks = 0;
+    if (endpoint) {
+      const T gg = Dq.squaredNorm() + Dp.squaredNorm();
+      if (value_of(gg) > 0) {
+        const T kappa = lambda.dot(Wb * Dp) / gg;
+        kq = kappa * Dq;
+        kp = kappa * Dp;
+        ks = std::abs(value_of(kappa));
+      }
+    }
     for (int i = 0; i < n; ++i) {
-      (*r)[i] = q1[i] - cst<T>(q0[i]) - cst<T>(h) * Dp[i];                // (q1 - q0)/h = gradbar_p H
-      (*r)[n + i] = p1[i] - cst<T>(p0[i]) + cst<T>(h) * (Dq[i] - fc[i]);  // (p1 - p0)/h = -gradbar_q H + omega^T lambda
+      (*r)[i] = q1[i] - cst<T>(q0[i]) - cst<T>(h) * (Dp[i] - kq[i]);              // (q1 - q0)/h = gradbar_p H
+      (*r)[n + i] = p1[i] - cst<T>(p0[i]) + cst<T>(h) * (Dq[i] - fc[i] + kp[i]);  // (p1 - p0)/h = -gradbar_q H + omega^T lambda
       if (terms) {
-        (*terms)[i] = std::abs(value_of(q1[i])) + std::abs(q0[i]) + std::abs(h) * sp[i];
+        (*terms)[i] = std::abs(value_of(q1[i])) + std::abs(q0[i]) + std::abs(h) * (sp[i] + ks * sq[i]);
         double fs = 0;
         for (int a = 0; a < m; ++a) fs += std::abs(value_of(Wb(a, i)) * value_of(lambda[a]));
-        (*terms)[n + i] = std::abs(value_of(p1[i])) + std::abs(p0[i]) + std::abs(h) * (sq[i] + fs);
+        (*terms)[n + i] = std::abs(value_of(p1[i])) + std::abs(p0[i]) + std::abs(h) * (sq[i] + fs + ks * sp[i]);
       }
+    }
+    if (endpoint) {  // omega(q1) V(q1, p1) = 0
+      const Mat<T, m, n> W1 = sys.template omega<T>(q1);
+      const Vec<T, n> v1 = velocity(sys, q1, p1);
+      for (int a = 0; a < m; ++a) {
+        T c = cst<T>(0.0);
+        double cs = 0;
+        for (int j = 0; j < n; ++j) {
+          c += W1(a, j) * v1[j];
+          cs += std::abs(value_of(W1(a, j)) * value_of(v1[j]));
+        }
+        (*r)[2 * n + a] = c;
+        if (terms) (*terms)[2 * n + a] = cs;
+      }
+      return;
     }
     for (int a = 0; a < m; ++a) {  // omega(qbar) gradbar_p H = 0
       T c = cst<T>(0.0);
@@ -150,7 +206,9 @@ class DiscreteGradientStepper {
   using VecM = Vec<double, m>;
   using Problem = DiscreteGradientProblem<S>;
 
-  explicit DiscreteGradientStepper(const S& sys, SolverOptions options = {});
+  // endpoint: the endpoint variant (above).
+  explicit DiscreteGradientStepper(const S& sys, SolverOptions options = {}, bool endpoint = false);
+  bool endpoint() const { return endpoint_; }
   // Do the passes see the force exactly (F affine in q; passes())?
   bool passes_exact_in_force() const { return affine_force_; }
   // Passes made since construction, those after a Gauss-Seidel first pass
@@ -170,7 +228,7 @@ class DiscreteGradientStepper {
     t.order = 2;
     t.symmetric = true;
     t.symmetric_in_phase = true;
-    t.holds_velocity_constraint = false;
+    t.holds_velocity_constraint = endpoint_;
     t.implicit = true;
     t.preserves_energy = true;
     return t;
@@ -200,7 +258,7 @@ class DiscreteGradientStepper {
 
   // Point k: q_k, v_k = V(q_k, p_k), p_k, the multiplier and the averaged
   // constraint omega(qbar) gradbar_p H of the step that arrived at k (0 at
-  // k = 0; zero to round-off).  It is evaluated here, when a point is
+  // k = 0; zero to round-off; the endpoint variant's: omega(q_k) v_k).  It is evaluated here, when a point is
   // recorded, not in every step (as the DLA and mp06 do theirs): it costs a
   // second discrete gradient, H(q_k, p_k) and omega.  The same arithmetic
   // either way.
@@ -209,11 +267,24 @@ class DiscreteGradientStepper {
   Vec<double, 2 * n> phase() const;
 
  private:
+  // The midpoint form's step (map() without the endpoint variant).
+  template <class Guess>
+  StepSummary map_midpoint(const Problem& prob, const Guess& explicit_guess, VecN* q1, VecN* p1, VecM* lambda) const;
+
   S sys_;
   SolverOptions options_;
+  bool endpoint_ = false;
   VecN q_ = VecN::Zero(), p_ = VecN::Zero();
   VecM lambda_ = VecM::Zero();
   long steps_ = 0;
+  // The endpoint variant's multipliers of the last steps of each h (step()).
+  struct StepMemory {
+    double h = 0;
+    VecM last = VecM::Zero(), prev = VecM::Zero();
+    int count = 0;
+  };
+  std::array<StepMemory, 8> memory_{};
+  int memory_next_ = 0;
   // The last successful step: its start (q, p) and size (sample()).
   VecN q_prev_ = VecN::Zero(), p_prev_ = VecN::Zero();
   double h_prev_ = 0;
@@ -283,17 +354,35 @@ struct DiscreteGradientMethod {
   static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
   static constexpr bool reports_p = true;
   static constexpr double step_cost = 15.0;
-  static std::string label(const MethodSpec&) { return name; }
+  static std::string label(const MethodSpec& spec) {
+    return spec.constraint == "endpoint" ? std::string(name) + " endpoint" : std::string(name);
+  }
   template <class S, class F>
   static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
     const SolverOptions opt = solver_options(spec);
-    return with_composition(DiscreteGradientStepper<S>(sys, opt), spec.composition, f);
+    if (spec.constraint != "midpoint" && spec.constraint != "endpoint")
+      throw std::invalid_argument("unknown constraint \"" + spec.constraint + "\" (midpoint or endpoint)");
+    return with_composition(DiscreteGradientStepper<S>(sys, opt, spec.constraint == "endpoint"), spec.composition, f);
   }
+  // The endpoint variant is "costly" (a Newton solve in 2n + m unknowns every
+  // step): in the studies of short runs, where its compositions' orders are
+  // the point (README "Methods").
   static std::vector<StudyEntry> study_entries() {
+    MethodSpec e = spec_of(name);
+    e.constraint = "endpoint";
+    const auto composed = [e](const char* c) {
+      MethodSpec s = e;
+      s.composition = c;
+      return s;
+    };
     return {{spec_of(name)},
             {spec_of(name, "triple_jump")},
             {spec_of(name, "suzuki5"), "variant"},
-            {spec_of(name, "order6"), "variant"}};
+            {spec_of(name, "order6"), "variant"},
+            {e, "costly"},
+            {composed("triple_jump"), "costly"},
+            {composed("suzuki5"), "costly"},
+            {composed("order6"), "costly"}};
   }
 };
 

@@ -16,6 +16,10 @@ struct MethodSpec {
   double tolerance = 1e-12;          // implicit methods: relative residual; the reference: CVODE rtol = atol
   std::string composition = "none";  // symmetric methods: composition.hpp
   int stages = 2;                    // spark: Lobatto IIIA-IIIB stages, 2, 3 or 4 (spark.hpp)
+  // discrete_gradient: where the velocity constraint holds, "midpoint" (the
+  // averaged form, odelab's) or "endpoint" (at every grid point, with the
+  // constraint force turned to do no discrete work; discrete_gradient.hpp).
+  std::string constraint = "midpoint";
   // Implicit methods: the start of each step's solve.  "predictor": the
   // method's own (extrapolation, passes); "continuation": the root continued
   // from h -> 0 (solver.hpp, root following).  root_check: with the

@@ -13,6 +13,8 @@
 //                  (discretization and alpha are the DLA's; other methods ignore them)
 //   stages         integer 2, 3 or 4: spark's Lobatto IIIA-IIIB stages, of order
 //                  2 stages - 2 (default 2; other methods ignore it)
+//   constraint     "midpoint" | "endpoint": where discrete_gradient holds the
+//                  velocity constraint (default "midpoint"; others ignore it)
 //   h              number > 0                                    (required)
 //   steps          integer >= 1                                  (required)
 //   tolerance      number in (0, 1): implicit methods' relative residual (default 1e-12),

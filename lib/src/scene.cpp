@@ -22,7 +22,8 @@ using namespace scene_detail;
 
 const std::vector<std::string> kKeys = {"system",         "params",      "q0",    "v0",    "method",
                                         "discretization", "alpha",       "h",     "steps", "tolerance",
-                                        "output_every",   "composition", "start", "stages"};
+                                        "output_every",   "composition", "start", "stages",
+                                        "constraint"};
 
 long peak_rss_kb() {
   rusage ru{};
@@ -56,6 +57,7 @@ json run_system(const S& sys, const json& sc) {
   spec.composition = sc["composition"];
   spec.start = sc["start"];
   spec.stages = sc["stages"];
+  spec.constraint = sc["constraint"];
   const RunReport rep = run_method(sys, spec, q0, v0, h, steps, rec);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu = cpu_seconds() - cpu0;
@@ -159,6 +161,7 @@ json catalog() {
           method_flags(m.spec.kind).uses_discretization ? json(m.spec.discretization) : json(nullptr)},
          {"alpha", method_flags(m.spec.kind).uses_discretization ? json(m.spec.alpha) : json(nullptr)},
          {"stages", m.spec.kind == SparkMethod::name ? json(m.spec.stages) : json(nullptr)},
+         {"constraint", m.spec.kind == DiscreteGradientMethod::name ? json(m.spec.constraint) : json(nullptr)},
          {"composition", m.spec.composition},
          {"order", t.order},
          {"symmetric", t.symmetric},
@@ -249,6 +252,8 @@ json validate_scene(const json& scene) {
   if (!(alpha >= 0.0 && alpha <= 1.0)) fail("alpha", "must be in [0, 1], got " + show(scene["alpha"]));
   r["alpha"] = alpha;
   r["stages"] = scene.contains("stages") ? integer(scene["stages"], "stages", 2, 4) : 2L;
+  r["constraint"] =
+      scene.contains("constraint") ? one_of(scene["constraint"], "constraint", {"midpoint", "endpoint"}) : "midpoint";
   r["start"] = scene.contains("start") ? one_of(scene["start"], "start", {"predictor", "continuation"}) : "predictor";
   r["composition"] =
       scene.contains("composition") ? one_of(scene["composition"], "composition", composition_names()) : "none";
