@@ -1,0 +1,49 @@
+// The user's own loop instead of nhi::integrate: start, step, sample, and a
+// failed step handled.  The knife edge (knife_edge.hpp) with mp06, then RK4
+// with a step far beyond its stability limit, whose state overflows: that
+// step reports a failure, which the loop prints before it stops.
+#include <cmath>
+#include <cstdio>
+
+#include "knife_edge.hpp"
+#include "nhi/mp06_body.hpp"  // mp06's step, compiled here for KnifeEdge
+#include "nhi/rk4.hpp"
+
+// Step from (q0, v0) with step h; print every `every`-th point.  Returns the
+// index of the step that failed, or 0 when all did.
+template <class Stepper>
+long loop(Stepper& stepper, const KnifeEdge& knife, double h, long steps, long every) {
+  const nhi::Vec<double, 3> q0(0.0, 0.0, 0.0), v0(1.0, 0.0, 1.0);
+  stepper.start(q0, v0);
+  nhi::Sample<3, 1> s;
+  for (long k = 1; k <= steps; ++k) {
+    const nhi::StepSummary step = stepper.step(h);
+    if (!step.ok()) {
+      std::printf("  step %ld (t = %g) failed (%s): %s\n", k, k * h, nhi::to_string(step.failure),
+                  step.message.c_str());
+      return k;
+    }
+    stepper.sample(&s);  // the point just reached (mp06 and RK4 report it at once: lag 0)
+    if (k % every == 0)
+      std::printf("  t = %6.1f  q = (%8.4f, %8.4f, %8.4f)  E = %.12f  omega(q) v = %9.2e\n", k * h, s.q[0], s.q[1],
+                  s.q[2], nhi::energy(knife, s.q, s.v), nhi::constraint_values(knife, s.q, s.v)[0]);
+  }
+  return 0;
+}
+
+int main() {
+  const KnifeEdge knife;
+  std::printf("mp06, h = 0.1:\n");
+  nhi::Mp06Stepper<KnifeEdge> mp06(knife);
+  if (loop(mp06, knife, 0.1, 1000, 200) != 0) return 1;
+
+  std::printf("rk4, h = 10 (stable only for h |phid| < 2.8):\n");
+  nhi::Rk4Stepper<KnifeEdge> rk4(knife);
+  const long failed = loop(rk4, knife, 10.0, 1000, 1000);
+  if (failed == 0) {
+    std::printf("  expected a failed step, got none\n");
+    return 1;
+  }
+  std::printf("  handled: the run stopped at step %ld, every state before it finite\n", failed);
+  return 0;
+}
