@@ -60,11 +60,11 @@ int main() {
   odeint::integrate_const(stepper, ode, x, 0.0, T + h / 2, h, std::ref(rk4));
   rk4.print("odeint runge_kutta4, integrate_const");
 
-  // ... and with nhi's mp06: one line changed (the system is ignored: mp06
-  // has the knife edge's Lagrangian and constraint).
-  nhi::OdeintStepper<nhi::Mp06Stepper<KnifeEdge>> mp06{nhi::Mp06Stepper<KnifeEdge>(knife)};
+  // ... and with nhi's mp06: the stepper line changed (the system is
+  // ignored: mp06 has the knife edge's Lagrangian and constraint).
   x = x0;
   Watch nh{knife};
+  nhi::OdeintStepper<nhi::Mp06Stepper<KnifeEdge>> mp06{nhi::Mp06Stepper<KnifeEdge>(knife)};
   odeint::integrate_const(mp06, ode, x, 0.0, T + h / 2, h, std::ref(nh));
   nh.print("nhi mp06, integrate_const");
 

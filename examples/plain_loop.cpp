@@ -9,8 +9,20 @@
 #include "nhi/mp06_body.hpp"  // mp06's step, compiled here for KnifeEdge
 #include "nhi/rk4.hpp"
 
-// Step from (q0, v0) with step h; print every `every`-th point.  Returns the
-// index of the step that failed, or 0 when all did.
+namespace {
+
+long fail(long k, const nhi::StepSummary& step) {
+  std::printf("  step %ld failed (%s): %s\n", k, nhi::to_string(step.failure), step.message.c_str());
+  return k;
+}
+
+void print(const KnifeEdge& knife, double t, const nhi::Sample<3, 1>& s) {
+  std::printf("  t = %6.1f  q = (%8.4f, %8.4f, %8.4f)  E = %.12f  omega(q) v = %9.2e\n", t, s.q[0], s.q[1], s.q[2],
+              nhi::energy(knife, s.q, s.v), nhi::constraint_values(knife, s.q, s.v)[0]);
+}
+
+// Step from (q0, v0) with step h, printing every `every`-th point.  Returns
+// the index of the step that failed, or 0 when none did.
 template <class Stepper>
 long loop(Stepper& stepper, const KnifeEdge& knife, double h, long steps, long every) {
   const nhi::Vec<double, 3> q0(0.0, 0.0, 0.0), v0(1.0, 0.0, 1.0);
@@ -18,18 +30,14 @@ long loop(Stepper& stepper, const KnifeEdge& knife, double h, long steps, long e
   nhi::Sample<3, 1> s;
   for (long k = 1; k <= steps; ++k) {
     const nhi::StepSummary step = stepper.step(h);
-    if (!step.ok()) {
-      std::printf("  step %ld (t = %g) failed (%s): %s\n", k, k * h, nhi::to_string(step.failure),
-                  step.message.c_str());
-      return k;
-    }
-    stepper.sample(&s);  // the point just reached (mp06 and RK4 report it at once: lag 0)
-    if (k % every == 0)
-      std::printf("  t = %6.1f  q = (%8.4f, %8.4f, %8.4f)  E = %.12f  omega(q) v = %9.2e\n", k * h, s.q[0], s.q[1],
-                  s.q[2], nhi::energy(knife, s.q, s.v), nhi::constraint_values(knife, s.q, s.v)[0]);
+    if (!step.ok()) return fail(k, step);  // step.failure and step.message say why
+    stepper.sample(&s);                    // the point reached: s.q, s.v (mp06: s.p, s.lambda too)
+    if (k % every == 0) print(knife, k * h, s);
   }
   return 0;
 }
+
+}  // namespace
 
 int main() {
   const KnifeEdge knife;
