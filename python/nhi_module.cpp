@@ -121,7 +121,8 @@ py::array_t<double> rows(const json& a, long width) {
 }
 
 long constraint_count(const std::string& system) {
-  for (const auto& s : nhi::catalog()["systems"])
+  const json catalog = nhi::catalog();
+  for (const auto& s : catalog["systems"])
     if (s["name"] == system) return s["m"].get<long>();
   throw std::runtime_error("nhi: unknown system " + system);
 }

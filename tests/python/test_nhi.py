@@ -52,8 +52,11 @@ def assert_same_result(py, cli):
         assert (key in py) == (key in cli), key
         if key not in cli:
             continue
-        expected = np.array(cli[key], dtype=float)
         assert py[key].dtype == np.float64
+        if len(cli[key]) == 0:  # no point recorded: rows of the system's width
+            assert py[key].shape[0] == 0, key
+            continue
+        expected = np.array(cli[key], dtype=float)
         assert py[key].shape == expected.shape, key
         # Bit for bit: the same doubles, compared as integers.
         assert np.array_equal(py[key].view(np.int64), expected.view(np.int64)), key
@@ -169,7 +172,7 @@ def test_the_gil_is_released_during_a_run():
     # While one thread is inside nhi.run, another runs Python code: it records
     # clock readings inside the middle half of the run.  With the GIL held
     # through the run there can be none, however fast or slow the machine.
-    scene = {**load_scene("robot.json"), "steps": 20000, "output_every": 20000}
+    scene = {**load_scene("particle.json"), "method": "benchmark", "steps": 10000, "output_every": 10000}
     span = {}
 
     def runner():
