@@ -38,6 +38,6 @@ start.set_title("first 40 time units")
 for ax in (whole, start):
     ax.set_xlabel("t")
     ax.set_ylabel("E")
-    ax.legend(loc="lower left")
+whole.legend(loc="lower left")  # the same colours below
 fig.savefig(out, dpi=100)
 print(f"wrote {out}")
