@@ -4,9 +4,10 @@
 // OdeintStepper<St, State> models odeint's *Stepper* concept (stepper_category
 // stepper_tag; state_type, deriv_type, value_type, time_type, order_type;
 // order(); do_step(system, x, t, dt) and do_step(system, in, t, out, dt)), so
-// integrate_const, integrate_n_steps, integrate_times and integrate_adaptive
-// (which for a stepper_tag stepper takes steps of dt) drive it with any
-// odeint observer.  An odeint user changes the stepper line,
+// integrate_const and integrate_n_steps drive it with any odeint observer,
+// and integrate_times and integrate_adaptive too (for a stepper_tag stepper
+// they take steps of dt, shortened to meet the given times; the fixed-step
+// methods below refuse a shortened step).  An odeint user changes a line,
 //     runge_kutta4<state_type> stepper;
 //     nhi::OdeintStepper<nhi::Mp06Stepper<Knife>> stepper{nhi::Mp06Stepper<Knife>(knife)};
 // and describes the system by its Lagrangian and constraint one-forms
