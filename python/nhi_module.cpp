@@ -10,7 +10,10 @@
 //                       summary, stats, meta) as plain Python values.  The same
 //                       numbers as `nhi run`, bit for bit: both call
 //                       validate_scene() and run_scene() of the library.
-//                       The GIL is released while the scene runs.  A bad scene
+//                       The GIL is released while the scene runs, so threads
+//                       run scenes at once (stats.cpu_seconds and peak_rss_kb
+//                       are then the process's, every thread's); Ctrl-C is
+//                       seen only when the run returns.  A bad scene
 //                       raises ValueError with the runner's message (what `nhi
 //                       run` prints after "nhi: error: "); a run whose step
 //                       fails returns status "failed", as the runner does.

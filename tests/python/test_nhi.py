@@ -189,3 +189,21 @@ def test_the_gil_is_released_during_a_run():
     start, end = span["start"], span["end"]
     middle = [r for r in readings if start + 0.25 * (end - start) < r < end - 0.25 * (end - start)]
     assert middle, f"no Python code ran during the {end - start:.3f} s run"
+
+
+def test_runs_in_threads_at_once_are_the_runs_alone():
+    scenes = [{**load_scene("particle.json"), "method": m, "steps": 2000} for m in ("dla", "mp06", "rk4", "benchmark")]
+    alone = [nhi.run(s) for s in scenes]
+    together = [None] * len(scenes)
+
+    def runner(i):
+        together[i] = nhi.run(scenes[i])
+
+    threads = [threading.Thread(target=runner, args=(i,)) for i in range(len(scenes))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for a, b in zip(alone, together):
+        for key in ("t", "q", "v", "energy", "constraint"):
+            assert np.array_equal(a[key], b[key]), key
