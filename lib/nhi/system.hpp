@@ -7,16 +7,17 @@
 //   template <class T> T lagrangian(const Vec<T,n>& q, const Vec<T,n>& v) const;
 //   template <class T> Mat<T,m,n> omega(const Vec<T,n>& q) const;
 // (checked at compile time: check_system() below) and, for RK4 and the
-// reference solution,
+// reference solution (check_system_ode()),
 //   Vec<double,n> acceleration(const Vec<double,n>& q, const Vec<double,n>& v) const;
-// A system that is a *scene* (listed in systems/registry.hpp, runnable by `nhi`
-// and every study) also has
+// That is all a system of one's own needs (examples/knife_edge.hpp).  A system
+// that is a *scene* (listed in systems/registry.hpp, runnable by `nhi` and
+// every study) has acceleration() and also
 //   static constexpr const char* name;
-//   Vec<double,n> acceleration(const Vec<double,n>& q, const Vec<double,n>& v) const;
 //   static auto parameters();          // std::array of Param<S>: name, member, check
 //   static Vec<double,n> default_q0(), default_v0();   // its default initial state
 // and optionally
 //   template <class T> void partials(q, v, Vec<T,n>* dLdq, Vec<T,n>* dLdv) const;
+//   static constexpr bool separable = true;  // and velocity(q, p): hamiltonian.hpp
 //   static constexpr int l;  template <class T> Vec<T,l> g(const Vec<T,n>& q) const;
 // and capability declarations the tests and studies select on (traits below):
 //   static constexpr bool reversible = true;  // L, omega invariant under (q, v) -> (q, -v)
