@@ -22,7 +22,10 @@
 //   nhi.methods()       every method the studies run: label, the scene keys
 //                       that select it, order, symmetric, implicit, ...
 //   nhi.compositions()  the compositions: name, order, stages
-// (the lists of `nhi list --json`).
+// (the lists of `nhi list --json`), and
+//   nhi.scene_defaults() the scene keys that have defaults, with them (what
+//                       validate_scene() fills in: discretization, alpha,
+//                       stages, composition, start, tolerance, output_every).
 //
 // One translation unit over the compiled library: it instantiates no stepper.
 #include <pybind11/numpy.h>
@@ -175,6 +178,20 @@ py::dict run(py::handle scene) {
   return result_to_python(result);
 }
 
+// The defaults validate_scene() fills in, read off a minimal scene of the
+// first registered system.
+py::dict scene_defaults() {
+  const json catalog = nhi::catalog();
+  const json& first = catalog["systems"][0];
+  const json minimal = {{"system", first["name"]}, {"q0", first["q0"]}, {"v0", first["v0"]},
+                        {"method", catalog["methods"][0]["method"]}, {"h", 1.0}, {"steps", 1}};
+  json resolved = nhi::validate_scene(minimal);
+  py::dict d;
+  for (const auto& [key, value] : resolved.items())
+    if (!minimal.contains(key) && key != "params") d[py::str(key)] = to_python(value);
+  return d;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(nhi, mod) {
@@ -195,4 +212,7 @@ PYBIND11_MODULE(nhi, mod) {
   mod.def(
       "compositions", [] { return to_python(nhi::catalog()["compositions"]); },
       "The compositions of a symmetric method: name, order, stages.");
+  mod.def("scene_defaults", &scene_defaults,
+          "The optional scene keys and their defaults (discretization, alpha, stages, composition, start, tolerance,\n"
+          "output_every).");
 }
