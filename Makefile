@@ -1,5 +1,7 @@
 # Two commands on a fresh Debian machine:
 #   make test        build and run the test suite (what CI runs)
+#   make examples    install the package to a temporary prefix, build examples/
+#                    out of tree against it and run them (CI runs it too)
 #   make reproduce   regenerate the figure runs, the short studies, the summary
 #                    and every figure; check that the large tables are current
 #   make sweep       regenerate the large tables (long runs, many states, timings)
@@ -7,12 +9,13 @@
 
 DEB_PACKAGES := cmake ninja-build g++ make libeigen3-dev libceres-dev libsundials-dev \
                 nlohmann-json3-dev libcli11-dev libgtest-dev libbenchmark-dev libboost-dev \
-                gnuplot-nox jq git libopenmpi-dev openmpi-bin clang libclang-rt-14-dev
+                gnuplot-nox jq git libopenmpi-dev openmpi-bin clang libclang-rt-14-dev \
+                python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
 BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2
 
-.PHONY: all deps build test test-sanitize fuzz reproduce figures readme-tables sweep sweep-results check-sweep \
+.PHONY: all deps build test test-sanitize examples fuzz reproduce figures readme-tables sweep sweep-results check-sweep \
         sweep-scaling clean
 all: build
 
@@ -55,13 +58,37 @@ $(BUILD)/bin/%:
 TEST_CXX ?= clang++
 TEST_BUILD ?= $(BUILD)-test
 NEW_TREE = $(if $(wildcard $(1)/CMakeCache.txt),,-G Ninja)
-# Only what the tests run: the library, the test executables, and the runner,
-# studies and benchmark that the command-line tests start.
+# Debian's Python, whose packages (pybind11, NumPy, pytest, matplotlib) make deps installs.
+PYTHON ?= /usr/bin/python3
+TEST_CONFIGURE = cmake -S . -B $(TEST_BUILD) $(call NEW_TREE,$(TEST_BUILD)) -DCMAKE_CXX_COMPILER=$(TEST_CXX) \
+	  -DCMAKE_BUILD_TYPE=Release -DNHI_NATIVE=OFF -DNHI_PYTHON=ON -DPython3_EXECUTABLE=$(PYTHON)
+# Only what the tests run: the library, the test executables, the Python
+# module, and the runner, studies and benchmark that the command-line tests start.
 test: deps
-	cmake -S . -B $(TEST_BUILD) $(call NEW_TREE,$(TEST_BUILD)) -DCMAKE_CXX_COMPILER=$(TEST_CXX) \
-	  -DCMAKE_BUILD_TYPE=Release -DNHI_NATIVE=OFF
+	$(TEST_CONFIGURE)
 	cmake --build $(TEST_BUILD) -j$(JOBS) --target nhi_tests
 	ctest --test-dir $(TEST_BUILD) --output-on-failure -j$(JOBS)
+
+# The package used from outside (README "Use it from your code"): install the
+# test tree's library, headers, runner and Python module to a temporary
+# prefix, build examples/ out of tree against it (its build time is printed),
+# run each example and the Python one, and check that the README's snippets
+# are the examples' code.  After make test it builds nothing in $(TEST_BUILD).
+EXAMPLES := user_system plain_loop odeint_interop
+examples: deps
+	$(TEST_CONFIGURE)
+	cmake --build $(TEST_BUILD) -j$(JOBS) --target nhi nhi_cli nhi_python
+	d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && set -e && \
+	cmake --install $(TEST_BUILD) --prefix $$d/prefix > $$d/install.log && \
+	cmake -S examples -B $$d/build -G Ninja -DCMAKE_CXX_COMPILER=$(TEST_CXX) -DCMAKE_PREFIX_PATH=$$d/prefix \
+	  > $$d/configure.log && \
+	t0=$$(date +%s) && cmake --build $$d/build -j$(JOBS) && \
+	echo "examples: built out of tree in $$(( $$(date +%s) - t0 )) s" && \
+	for e in $(EXAMPLES); do echo "== examples/$$e"; $$d/build/$$e; done && \
+	echo "== examples/python/fig1.py" && \
+	PYTHONPATH=$$(echo $$d/prefix/lib*/python3*/dist-packages) $(PYTHON) examples/python/fig1.py \
+	  experiments/scenes/particle_fig12.json $$d/fig1.png && \
+	$(PYTHON) tests/readme_snippets.py README.md examples
 
 # The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its
 # own build tree (-O1 with line tables, for readable reports).

@@ -273,6 +273,8 @@ class DlaMap {
 // known (lag 1).
 template <class S, class D>
 class DlaStepper {
+  static_assert(check_system<S>());  // a clear message for a type that is not a system (system.hpp)
+
  public:
   static constexpr int n = S::n, m = S::m;
   static constexpr int lag = 1;

@@ -310,6 +310,8 @@ struct Mp06SeparableProblem {
 // start, map, step, sample, phase) are in mp06_body.hpp.
 template <class S, bool kSeparableForm = is_separable<S>::value>
 class Mp06Stepper {
+  static_assert(check_system<S>());  // a clear message for a type that is not a system (system.hpp)
+
  public:
   static constexpr bool kSeparable = kSeparableForm && is_separable<S>::value;
   static constexpr int n = S::n, m = S::m;

@@ -128,6 +128,8 @@ class CvodeReference {
 // interval).  rhs_evaluations and internal_steps are CVODE's own counts.
 template <class S>
 class ReferenceStepper {
+  static_assert(check_system_ode<S>());  // a clear message for a type that is not a system (system.hpp)
+
  public:
   static constexpr int n = S::n, m = S::m;
   static constexpr int lag = 0;

@@ -14,6 +14,8 @@ namespace nhi {
 
 template <class S>
 class Rk4Stepper {
+  static_assert(check_system_ode<S>());  // a clear message for a type that is not a system (system.hpp)
+
  public:
   static constexpr int n = S::n, m = S::m;
   static constexpr int lag = 0;

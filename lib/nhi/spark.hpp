@@ -299,6 +299,8 @@ struct SparkProblem {
 // members that solve (start, map, step, sample, phase) are in spark_body.hpp.
 template <class S, int s>
 class SparkStepper {
+  static_assert(check_system<S>());  // a clear message for a type that is not a system (system.hpp)
+
  public:
   static constexpr int n = S::n, m = S::m;
   static constexpr int lag = 0;

@@ -4,16 +4,20 @@
 //
 // A system is a plain type with
 //   static constexpr int n, m;                       // dim Q, number of constraints
-//   static constexpr const char* name;
 //   template <class T> T lagrangian(const Vec<T,n>& q, const Vec<T,n>& v) const;
 //   template <class T> Mat<T,m,n> omega(const Vec<T,n>& q) const;
-// A system that is a *scene* (listed in systems/registry.hpp, runnable by `nhi`
-// and every study) also has
+// (checked at compile time: check_system() below) and, for RK4 and the
+// reference solution (check_system_ode()),
 //   Vec<double,n> acceleration(const Vec<double,n>& q, const Vec<double,n>& v) const;
+// That is all a system of one's own needs (examples/knife_edge.hpp).  A system
+// that is a *scene* (listed in systems/registry.hpp, runnable by `nhi` and
+// every study) has acceleration() and also
+//   static constexpr const char* name;
 //   static auto parameters();          // std::array of Param<S>: name, member, check
 //   static Vec<double,n> default_q0(), default_v0();   // its default initial state
 // and optionally
 //   template <class T> void partials(q, v, Vec<T,n>* dLdq, Vec<T,n>* dLdv) const;
+//   static constexpr bool separable = true;  // and velocity(q, p): hamiltonian.hpp
 //   static constexpr int l;  template <class T> Vec<T,l> g(const Vec<T,n>& q) const;
 // and capability declarations the tests and studies select on (traits below):
 //   static constexpr bool reversible = true;  // L, omega invariant under (q, v) -> (q, -v)
@@ -111,6 +115,70 @@ template <class S, class = void>
 struct has_reduced_flow : std::false_type {};
 template <class S>
 struct has_reduced_flow<S, std::void_t<decltype(&S::reduced_flow)>> : std::true_type {};
+
+// The concept's required part, checked at compile time: every stepper opens
+// with static_assert(check_system<S>()) (RK4 and the reference solution with
+// check_system_ode<S>()), so that a type which is not a system fails with one
+// of the messages below before any error from inside a method.
+template <class S, class = void>
+struct has_dimensions : std::false_type {};
+template <class S>
+struct has_dimensions<S, std::enable_if_t<std::is_same_v<decltype(S::n), const int> &&
+                                          std::is_same_v<decltype(S::m), const int> && (S::n > 0) && (S::m >= 0)>>
+    : std::true_type {};
+
+template <class S, class T, class = void>
+struct has_lagrangian : std::false_type {};
+template <class S, class T>
+struct has_lagrangian<S, T,
+                      std::enable_if_t<std::is_same_v<decltype(std::declval<const S&>().template lagrangian<T>(
+                                                          std::declval<const Vec<T, S::n>&>(),
+                                                          std::declval<const Vec<T, S::n>&>())),
+                                                      T>>> : std::true_type {};
+
+template <class S, class T, class = void>
+struct has_omega : std::false_type {};
+template <class S, class T>
+struct has_omega<S, T,
+                 std::enable_if_t<std::is_same_v<
+                     std::decay_t<decltype(std::declval<const S&>().template omega<T>(std::declval<const Vec<T, S::n>&>()))>,
+                     Mat<T, S::m, S::n>>>> : std::true_type {};
+
+template <class S, class = void>
+struct has_acceleration : std::false_type {};
+template <class S>
+struct has_acceleration<S, std::enable_if_t<std::is_same_v<
+                               std::decay_t<decltype(std::declval<const S&>().acceleration(
+                                   std::declval<const Vec<double, S::n>&>(), std::declval<const Vec<double, S::n>&>()))>,
+                               Vec<double, S::n>>>> : std::true_type {};
+
+template <class S>
+constexpr bool check_system() {
+  static_assert(has_dimensions<S>::value,
+                "nhi system concept: the system type needs `static constexpr int n` (dim Q, > 0) and "
+                "`static constexpr int m` (the number of constraint one-forms)");
+  if constexpr (has_dimensions<S>::value) {
+    static_assert(has_lagrangian<S, double>::value && has_lagrangian<S, ceres::Jet<double, S::n>>::value,
+                  "nhi system concept: the system type needs `template <class T> T lagrangian(const Vec<T, n>& q, "
+                  "const Vec<T, n>& v) const`, generic in the scalar T (double and ceres::Jet)");
+    static_assert(has_omega<S, double>::value && has_omega<S, ceres::Jet<double, S::n>>::value,
+                  "nhi system concept: the system type needs `template <class T> Mat<T, m, n> omega(const Vec<T, n>& "
+                  "q) const`, the constraint one-forms as the rows of an m x n matrix, generic in the scalar T");
+  }
+  return true;
+}
+
+// What RK4 and the reference solution need besides: the index-reduced ODE.
+template <class S>
+constexpr bool check_system_ode() {
+  check_system<S>();
+  if constexpr (has_dimensions<S>::value)
+    static_assert(has_acceleration<S>::value,
+                  "nhi system concept: RK4 and the reference solution need `Vec<double, n> acceleration(const "
+                  "Vec<double, n>& q, const Vec<double, n>& v) const`, the index-reduced ODE (nhi::"
+                  "generic_acceleration(*this, q, v) derives it from L and omega)");
+  return true;
+}
 
 // Does the system hand-write its partials (the optional fast path)?
 template <class S, class T, class = void>

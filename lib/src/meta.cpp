@@ -14,7 +14,9 @@ namespace nhi {
 json meta() {
   char when[32];
   const std::time_t now = std::time(nullptr);
-  std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  std::tm utc{};
+  gmtime_r(&now, &utc);  // not gmtime's shared buffer: Python threads run scenes at once (python/)
+  std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &utc);
   return {{"git_revision", NHI_GIT_REVISION},
           {"git_dirty", NHI_GIT_DIRTY},
 #ifdef __clang__
