@@ -171,8 +171,8 @@ def test_lists_are_those_of_nhi_list(tmp_path):
 def test_scene_defaults_are_what_a_run_fills_in():
     # README "Scene format": the defaults of the optional keys.
     defaults = nhi.scene_defaults()
-    assert defaults == {"discretization": "alpha", "alpha": 0.5, "stages": 2, "composition": "none",
-                        "start": "predictor", "tolerance": 1e-12, "output_every": 1}
+    assert defaults == {"discretization": "alpha", "alpha": 0.5, "stages": 2, "constraint": "midpoint",
+                        "composition": "none", "start": "predictor", "tolerance": 1e-12, "output_every": 1}
     scene = {k: v for k, v in load_scene("particle.json").items() if k in ("system", "q0", "v0", "method", "h")}
     resolved = nhi.run({**scene, "steps": 3})["scene"]
     assert {k: resolved[k] for k in defaults} == defaults
