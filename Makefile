@@ -15,7 +15,7 @@ BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2
 
-.PHONY: all deps build test test-sanitize examples fuzz reproduce figures readme-tables sweep sweep-results check-sweep \
+.PHONY: all deps build install test test-sanitize examples fuzz reproduce figures readme-tables sweep sweep-results check-sweep \
         sweep-scaling clean
 all: build
 
@@ -35,52 +35,55 @@ deps:
 	$(call APT,$(DEB_PACKAGES))
 
 
+# One build tree ($(BUILD)) and one compiler (CXX, clang++ by default: it
+# compiles this code's templates in less than half of g++'s time) for
+# everything: the library, the runner, the studies, the benchmark, the tests,
+# the Python module ($(BUILD)/python) and the examples' install.
 # NATIVE=ON builds for this CPU (faster, but results are then this CPU's own;
 # see CMakeLists.txt).
 NATIVE ?= OFF
+CXX := clang++
+# Debian's Python, whose packages (pybind11, NumPy, pytest, matplotlib) make deps installs.
+PYTHON ?= /usr/bin/python3
 # Ninja for a new build tree (about half the build time of the Makefile
 # generator here); an existing tree keeps the generator it was made with.
-GENERATOR = $(if $(wildcard $(BUILD)/CMakeCache.txt),,-G Ninja)
-CONFIGURE = cmake -S . -B $(BUILD) $(GENERATOR) -DCMAKE_BUILD_TYPE=Release -DNHI_NATIVE=$(NATIVE)
-# The runner, the studies and the benchmark (the tests build in $(TEST_BUILD), below).
+NEW_TREE = $(if $(wildcard $(1)/CMakeCache.txt),,-G Ninja)
+CONFIGURE = cmake -S . -B $(BUILD) $(call NEW_TREE,$(BUILD)) -DCMAKE_CXX_COMPILER=$(CXX) \
+	  -DCMAKE_BUILD_TYPE=Release -DNHI_NATIVE=$(NATIVE) -DNHI_PYTHON=ON -DPython3_EXECUTABLE=$(PYTHON)
+# The runner, the studies, the benchmark and the Python module.
 build: deps
 	$(CONFIGURE)
-	cmake --build $(BUILD) -j$(JOBS) --target nhi_experiments
+	cmake --build $(BUILD) -j$(JOBS) --target nhi_experiments nhi_python
 
 # A figure or study target asked for directly builds the binaries if they are missing.
 $(BUILD)/bin/%:
 	$(MAKE) build
 
-# The tests build with TEST_CXX in trees of their own: clang compiles this
-# code's templates in less than half of g++'s time, with the same numbers.
-# The experiments build with the default compiler (g++ on Debian) in $(BUILD),
-# whose DLA steps are the faster on some scenes.
-TEST_CXX ?= clang++
-TEST_BUILD ?= $(BUILD)-test
-NEW_TREE = $(if $(wildcard $(1)/CMakeCache.txt),,-G Ninja)
-# Debian's Python, whose packages (pybind11, NumPy, pytest, matplotlib) make deps installs.
-PYTHON ?= /usr/bin/python3
-TEST_CONFIGURE = cmake -S . -B $(TEST_BUILD) $(call NEW_TREE,$(TEST_BUILD)) -DCMAKE_CXX_COMPILER=$(TEST_CXX) \
-	  -DCMAKE_BUILD_TYPE=Release -DNHI_NATIVE=OFF -DNHI_PYTHON=ON -DPython3_EXECUTABLE=$(PYTHON)
-# Only what the tests run: the library, the test executables, the Python
-# module, and the runner, studies and benchmark that the command-line tests start.
+# The test executables, the Python module, and the runner, studies and
+# benchmark that the command-line tests start (the rest of make build).
 test: deps
-	$(TEST_CONFIGURE)
-	cmake --build $(TEST_BUILD) -j$(JOBS) --target nhi_tests
-	ctest --test-dir $(TEST_BUILD) --output-on-failure -j$(JOBS)
+	$(CONFIGURE)
+	cmake --build $(BUILD) -j$(JOBS) --target nhi_tests
+	ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
+
+# Headers, libnhi.a, the runner, the CMake package and the Python module to
+# PREFIX (no sudo: the prefix must be writable).
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
 
 # The package used from outside (README "Use it from your code"): install the
-# test tree's library, headers, runner and Python module to a temporary
+# build tree's library, headers, runner and Python module to a temporary
 # prefix, build examples/ out of tree against it (its build time is printed),
 # run each example and the Python one, and check that the README's snippets
-# are the examples' code.  After make test it builds nothing in $(TEST_BUILD).
+# are the examples' code.  After make test it builds nothing in $(BUILD).
 EXAMPLES := user_system plain_loop odeint_interop
 examples: deps
-	$(TEST_CONFIGURE)
-	cmake --build $(TEST_BUILD) -j$(JOBS) --target nhi nhi_cli nhi_python
+	$(CONFIGURE)
+	cmake --build $(BUILD) -j$(JOBS) --target nhi nhi_cli nhi_python
 	d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && set -e && \
-	cmake --install $(TEST_BUILD) --prefix $$d/prefix > $$d/install.log && \
-	cmake -S examples -B $$d/build -G Ninja -DCMAKE_CXX_COMPILER=$(TEST_CXX) -DCMAKE_PREFIX_PATH=$$d/prefix \
+	cmake --install $(BUILD) --prefix $$d/prefix > $$d/install.log && \
+	cmake -S examples -B $$d/build -G Ninja -DCMAKE_CXX_COMPILER=$(CXX) -DCMAKE_PREFIX_PATH=$$d/prefix \
 	  > $$d/configure.log && \
 	t0=$$(date +%s) && cmake --build $$d/build -j$(JOBS) && \
 	echo "examples: built out of tree in $$(( $$(date +%s) - t0 )) s" && \
@@ -93,7 +96,7 @@ examples: deps
 # The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer, in its
 # own build tree (-O1 with line tables, for readable reports).
 test-sanitize: deps
-	cmake -S . -B $(BUILD)-sanitize $(call NEW_TREE,$(BUILD)-sanitize) -DCMAKE_CXX_COMPILER=$(TEST_CXX) \
+	cmake -S . -B $(BUILD)-sanitize $(call NEW_TREE,$(BUILD)-sanitize) -DCMAKE_CXX_COMPILER=$(CXX) \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DNHI_NATIVE=OFF -DNHI_SANITIZE=ON
 	cmake --build $(BUILD)-sanitize -j$(JOBS) --target nhi_tests
 	UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir $(BUILD)-sanitize --output-on-failure -j$(JOBS)

@@ -1,6 +1,7 @@
 // A system of the user's own (knife_edge.hpp, not in the library's registry)
-// integrated with mp06, its order-4 composition, the paper's DLA, RK4 and a
-// method of one's own (euler.hpp) through nhi::integrate, printing each
+// integrated with mp06, its order-4 composition, the paper's DLA, RK4, the
+// adaptive pair rkf78, the discrete gradient and a method of one's own
+// (euler.hpp) through nhi::integrate, printing each
 // method's energy error, constraint error and error against the closed form.  Exit 1 if a run fails or a
 // method misses what its theory promises here.
 #include <algorithm>
@@ -9,11 +10,7 @@
 
 #include "euler.hpp"
 #include "knife_edge.hpp"
-#include "nhi/composition.hpp"
-#include "nhi/dla_body.hpp"   // the DLA's step, compiled here for KnifeEdge
-#include "nhi/integrate.hpp"
-#include "nhi/mp06_body.hpp"  // mp06's step, the same
-#include "nhi/rk4.hpp"
+#include "nhi/all.hpp"  // every stepper, its step compiled here for KnifeEdge
 
 namespace {
 
@@ -62,13 +59,20 @@ int main() {
                          knife, h, steps);
   const Errors rk4 = run("rk4", nhi::Rk4Stepper<KnifeEdge>(knife), knife, h, steps);
   const Errors euler = run("euler (euler.hpp)", nhi::EulerStepper<KnifeEdge>(knife), knife, h, steps);
+  nhi::EmbeddedRkOptions tight;
+  tight.atol = tight.rtol = 1e-10;
+  const Errors rkf78 = run("rkf78 (tol 1e-10)", nhi::EmbeddedRkStepper<KnifeEdge, nhi::Rkf78Pair>(knife, tight), knife,
+                           h, steps);
+  const Errors dg = run("discrete_gradient", nhi::DiscreteGradientStepper<KnifeEdge>(knife), knife, h, steps);
 
   // What each method's theory says here: mp06 holds the constraint at
   // round-off, and its composition is the more accurate; RK4 does not hold
-  // the constraint; Euler, of order 1, is the least accurate.
-  const bool as_expected = mp06.ok && tj.ok && dla.ok && rk4.ok && euler.ok && mp06.constraint < 1e-12 &&
-                           tj.constraint < 1e-12 && tj.position < mp06.position &&
-                           rk4.constraint > 1e3 * mp06.constraint && euler.position > dla.position;
+  // the constraint; Euler, of order 1, is the least accurate; rkf78 at
+  // 1e-10 is the most accurate; the discrete gradient keeps the energy.
+  const bool as_expected = mp06.ok && tj.ok && dla.ok && rk4.ok && euler.ok && rkf78.ok && dg.ok &&
+                           mp06.constraint < 1e-12 && tj.constraint < 1e-12 && tj.position < mp06.position &&
+                           rk4.constraint > 1e3 * mp06.constraint && euler.position > dla.position &&
+                           rkf78.position < tj.position && dg.energy < 1e-12;
   if (!as_expected) std::printf("unexpected: a run failed or a method missed its theory's claim\n");
   return as_expected ? 0 : 1;
 }

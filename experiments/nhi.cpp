@@ -1,21 +1,72 @@
 // nhi: run one scene, or list what the library has.
 //   nhi run SCENE.json [--set key=value]... [-o OUT.json]
 //   nhi list [--markdown | --json]   systems (parameters, defaults), methods, compositions
+//   nhi --version                    version, git revision, compiler, build flags
 // Exit status: 0 run ok; 3 run ended with status "failed" (the result is still
-// written); 2 bad input or unwritable output (nothing written); 130 interrupted
-// by SIGINT/SIGTERM (nothing written).  The output file is written to a
+// written); 2 bad input (an unknown subcommand too) or unwritable output
+// (nothing written); 130 interrupted by SIGINT/SIGTERM (nothing written).  The output file is written to a
 // temporary file in the same directory and renamed, so it is whole or absent.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "nhi/output.hpp"
 #include "nhi/scene.hpp"
+#include "nhi/scene_detail.hpp"
 #include "nhi/signals.hpp"
 
+// The CMake project version (CMakeLists.txt's project(... VERSION)); a build
+// may pass it as NHI_VERSION.  tests/test_runner_edges.cpp checks that the two agree.
+#ifndef NHI_VERSION
+#define NHI_VERSION "0.1.0"
+#endif
+
 namespace {
+
+const std::vector<std::string> kSubcommands = {"run", "list"};
+
+// `nhi --version`: the version and the provenance meta() records in every result.
+std::string version_text() {
+  const nhi::json m = nhi::meta();
+  std::string rev = m["git_revision"].get<std::string>();
+  if (m["git_dirty"].get<bool>()) rev += " (dirty)";
+  return std::string("nhi ") + NHI_VERSION + "\ngit revision: " + rev +
+         "\ncompiler: " + m["compiler"].get<std::string>() + "\nbuild flags: " + m["build_flags"].get<std::string>();
+}
+
+// A failure reason as the user reads it: std::to_string and printf write a
+// non-finite number as nan, -nan, inf or -inf; say NaN, Infinity, -Infinity.
+std::string nonfinite_words(const std::string& s) {
+  auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.'; };
+  std::string out;
+  for (size_t i = 0; i < s.size();) {
+    const bool start = i == 0 || !word(s[i - 1]);
+    bool done = false;
+    if (start)
+      for (const auto& [from, to] : {std::pair<const char*, const char*>{"-nan", "NaN"},
+                                     {"nan", "NaN"},
+                                     {"-inf", "-Infinity"},
+                                     {"inf", "Infinity"}}) {
+        const size_t k = std::strlen(from);
+        if (s.compare(i, k, from) == 0 && (i + k == s.size() || !word(s[i + k]))) {
+          out += to;
+          i += k;
+          done = true;
+          break;
+        }
+      }
+    if (!done) out += s[i++];
+  }
+  return out;
+}
 
 int error(const std::string& message, int code = 2) {
   std::cerr << "nhi: error: " << message << "\n";
@@ -90,6 +141,7 @@ int main(int argc, char** argv) {
   nhi::install_interrupt_handlers();
   CLI::App app{"Nonholonomic integrators (Cortes & Martinez 2001): run one scene"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", version_text, "Print the version, compiler and build flags and exit");
   auto* run = app.add_subcommand("run", "Run SCENE.json and write the result as JSON");
   std::string scene_path, out_path;
   std::vector<std::string> sets;
@@ -104,6 +156,16 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
+    // The subcommand is the first argument that is not an option (nhi has no
+    // options that take a value): name it if it is not one.
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a.empty() || a[0] == '-') continue;
+      if (std::find(kSubcommands.begin(), kSubcommands.end(), a) == kSubcommands.end())
+        return error("unknown subcommand " + nhi::scene_detail::show(nhi::json(a)) + " (expected run or list)" +
+                     nhi::scene_detail::did_you_mean(a, kSubcommands));
+      break;
+    }
     return error(e.what());
   }
   if (list->parsed()) {
@@ -156,12 +218,12 @@ int main(int argc, char** argv) {
     try {
       out->commit(text);
     } catch (const std::exception& e) {
-      return error(e.what(), 1);
+      return error(e.what(), 2);  // unwritable output: nothing written (AtomicFile removes its temporary)
     }
   }
   if (result["status"] != "ok") {
     std::cerr << "nhi: run failed at step " << result["failure"]["step"] << ": "
-              << result["failure"]["reason"].get<std::string>() << "\n";
+              << nonfinite_words(result["failure"]["reason"].get<std::string>()) << "\n";
     return 3;
   }
   return 0;

@@ -9,14 +9,20 @@
 // a method to study_methods() adds it to every study.
 #pragma once
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
+#include <exception>
 #include <functional>
 #include <iostream>
 #include <mutex>
@@ -52,9 +58,31 @@ inline std::chrono::steady_clock::time_point& start_time() {
   return t;
 }
 
+// The study's name in messages: its executable's (set by parse()).
+inline std::string& program_name() {
+  static std::string name = "study";
+  return name;
+}
+
+// "" if a result can be written at `path` (a file in an existing, writable
+// directory), else why not.  Checked when the command line is parsed, so that
+// an unwritable output fails before the study runs; nothing is created (a
+// study killed mid-run must leave no temporary file behind).
+inline std::string output_problem(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) return "output '" + path + "' is a directory";
+  const size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    return "cannot write output '" + path + "': " + dir + ": " + std::strerror(errno);
+  return "";
+}
+
 // The common options on `app` (a study adds its own before calling parse).
 inline void add_options(CLI::App& app, Options& o) {
-  app.add_option("-o,--output", o.out, "Result file (JSON)")->required();
+  app.add_option("-o,--output", o.out, "Result file (JSON)")
+      ->required()
+      ->check(CLI::Validator([](std::string& path) { return output_problem(path); }, "FILE", "writable output"));
   app.add_option("--scenes", o.scenes_dir, "Directory with one NAME.json per registered system");
   app.add_option("--threads", o.threads, "Worker threads (per rank under MPI)")->check(CLI::Range(1, 64));
   app.add_option("--only", o.only, "Run only these registered scenes (comma-separated)")
@@ -62,16 +90,61 @@ inline void add_options(CLI::App& app, Options& o) {
       ->check(CLI::IsMember(nhi::system_names()));
 }
 
+// A scene that cannot be loaded or is not valid ends the study: one line,
+// exit 2, nothing written (every rank alike: they all read the same files).
+// The usual cause is a study started away from the repository root, where
+// the default --scenes directory is not found.
+[[noreturn]] inline void scene_error_exit(const std::string& message) {
+  Cluster& cl = Cluster::get();
+  if (cl.root())
+    std::fprintf(stderr, "%s: error: %s (run from the repository root, or pass --scenes DIR)\n",
+                 program_name().c_str(), message.c_str());
+  cl.exit_all(2);
+}
+
+// The thread that parsed the command line (the one that may end the study).
+inline std::thread::id& main_thread() {
+  static std::thread::id id = std::this_thread::get_id();
+  return id;
+}
+
+// Installed by parse(): a nhi::SceneError that no study code catches (a
+// scene derived from a scene file and validated in main, say) ends the study
+// as scene_error_exit() does, not with an abort (exit 134).
+inline void on_terminate() {
+  if (const std::exception_ptr p = std::current_exception()) {
+    try {
+      std::rethrow_exception(p);
+    } catch (const nhi::SceneError& e) {
+      if (Cluster::get().root())
+        std::fprintf(stderr, "%s: error: %s (run from the repository root, or pass --scenes DIR)\n",
+                     program_name().c_str(), e.what());
+      Cluster::abort(2);
+    } catch (...) {
+    }
+  }
+  std::abort();
+}
+
 // Join the ranks (cluster.hpp), parse the command line and install the
-// interrupt handlers; exits on --help or a bad command line (every rank alike).
+// interrupt handlers; exits on --help (0) or a bad command line (2, one line
+// on stderr; every rank alike).
 inline void parse(CLI::App& app, int argc, char** argv) {
   start_time();
+  main_thread();
+  if (argc > 0 && argv[0]) {
+    const std::string a0 = argv[0];
+    program_name() = a0.substr(a0.find_last_of('/') + 1);
+  }
+  std::set_terminate(on_terminate);
   Cluster& cl = Cluster::get();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // Every rank parses the same line; only the first prints the help or error.
-    cl.exit_all(cl.root() ? app.exit(e) : e.get_exit_code());
+    if (e.get_exit_code() == 0) cl.exit_all(cl.root() ? app.exit(e) : 0);
+    if (cl.root()) std::fprintf(stderr, "%s: error: %s\n", program_name().c_str(), e.what());
+    cl.exit_all(2);
   }
   nhi::install_interrupt_handlers();
 }
@@ -92,9 +165,16 @@ inline std::vector<std::string> scene_names(const Options& o) {
   return out;
 }
 
-// The validated scene file of a scene name: SCENES/NAME.json.
+// The validated scene file of a scene name: SCENES/NAME.json.  A scene file
+// that cannot be read or is not valid ends the study (scene_error_exit());
+// off the main thread (inside a cell) it throws, and the cell fails.
 inline json scene(const Options& o, const std::string& name) {
-  return nhi::validate_scene(nhi::load_scene_file(o.scenes_dir + "/" + name + ".json"));
+  try {
+    return nhi::validate_scene(nhi::load_scene_file(o.scenes_dir + "/" + name + ".json"));
+  } catch (const nhi::SceneError& e) {
+    if (std::this_thread::get_id() != main_thread()) throw;
+    scene_error_exit(e.what());
+  }
 }
 
 // The methods of study_methods() that pass `keep`, in their fixed order.
@@ -113,17 +193,41 @@ inline double thread_cpu_seconds() {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-// A progress line on stderr: "label: done/total", rewritten at most twice a second.
+// Whether a progress line drawn with '\r' is open on stderr (a message then
+// starts on a new line).
+inline std::atomic<bool>& progress_line_open() {
+  static std::atomic<bool> open{false};
+  return open;
+}
+// "\n" if a message must first end an open progress line, else "".
+inline const char* end_progress_line() { return progress_line_open().exchange(false) ? "\n" : ""; }
+
+// Progress on stderr: "label: done/total runs".  On a terminal, one line
+// redrawn with '\r' at most twice a second; otherwise (a log file, a pipe)
+// one plain line at each tenth of the runs, the last at total.
 class Progress {
  public:
-  Progress(std::string label, long total) : label_(std::move(label)), total_(total) {}
+  Progress(std::string label, long total, bool terminal = ::isatty(STDERR_FILENO) == 1)
+      : label_(std::move(label)), total_(total), terminal_(terminal) {}
   void tick() {
     const long d = ++done_;
     std::lock_guard<std::mutex> lock(m_);
-    const auto now = std::chrono::steady_clock::now();
-    if (d == total_ || now - last_ > std::chrono::milliseconds(500)) {
-      last_ = now;
-      std::fprintf(stderr, "\r%s: %ld/%ld runs%s", label_.c_str(), d, total_, d == total_ ? "\n" : "");
+    if (terminal_) {
+      const auto now = std::chrono::steady_clock::now();
+      if (d == total_ || now - last_ > std::chrono::milliseconds(500)) {
+        last_ = now;
+        std::fprintf(stderr, "\r%s: %ld/%ld runs%s", label_.c_str(), d, total_, d == total_ ? "\n" : "");
+        progress_line_open() = d != total_;
+        std::fflush(stderr);
+      }
+      return;
+    }
+    // The tenth reached (d may arrive out of order from the threads: a
+    // tenth is printed once, by the first tick to reach it).
+    const long tenth = total_ > 0 ? d * 10 / total_ : 10;
+    if (tenth > printed_tenth_) {
+      printed_tenth_ = tenth;
+      std::fprintf(stderr, "%s: %ld/%ld runs\n", label_.c_str(), d, total_);
       std::fflush(stderr);
     }
   }
@@ -131,9 +235,11 @@ class Progress {
  private:
   std::string label_;
   long total_;
+  bool terminal_;
   std::atomic<long> done_{0};
   std::mutex m_;
   std::chrono::steady_clock::time_point last_{};
+  long printed_tenth_ = 0;
 };
 
 // Run task(i) for every i on `threads` workers; results land in their own slots.
@@ -319,15 +425,15 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
         }
   }
   if (interrupted) {
-    if (cl.root()) std::fprintf(stderr, "\nstudy: interrupted; nothing written\n");
+    if (cl.root()) std::fprintf(stderr, "%sstudy: interrupted; nothing written\n", end_progress_line());
     cl.exit_all(130);
   }
   if (!errors.empty()) {
     std::sort(errors.begin(), errors.end());
     if (cl.root())
       for (const auto& e : errors)
-        std::fprintf(stderr, "\nstudy: %s: %s failed: %s\n", c.label.c_str(), c.name(e.first).c_str(),
-                     e.second.c_str());
+        std::fprintf(stderr, "%sstudy: %s: %s failed: %s\n", end_progress_line(), c.label.c_str(),
+                     c.name(e.first).c_str(), e.second.c_str());
     if (cl.root()) std::fprintf(stderr, "study: failed; nothing written\n");
     cl.exit_all(1);
   }
@@ -368,8 +474,9 @@ inline int finish(const Options& o, json result) {
       nhi::AtomicFile f(o.out);
       f.commit(nhi::json_lines(result));
     } catch (const std::exception& e) {
-      std::cerr << "study: error: " << e.what() << "\n";
-      code = 1;
+      // AtomicFile's message names the path and says why (strerror).
+      std::cerr << program_name() << ": error: " << e.what() << "; nothing written\n";
+      code = 2;  // unwritable output (the exit-code contract)
     }
   }
   // Every rank leaves with the first rank's code.

@@ -74,22 +74,24 @@ json run_fate(const Grid& g, size_t i, const nhi::MethodSpec& spec, nhi::RunRepo
       const long steps = std::max(1L, std::lround(g.T / h));
       double max_dE = 0;
       long taken = 0;
+      // The threshold |E - E0| > |E0| through the runs' guard (guard.hpp),
+      // which also ends a run at a non-finite point, before the observer.
+      const nhi::RunReport rep = nhi::run_method(
+          sys, spec, q0, v0, h, steps,
+          [&](const nhi::Sample<S::n, S::m>& smp) {
+            max_dE = std::max(max_dE, std::abs(nhi::energy(sys, smp.q, smp.v) - E0));
+            taken = smp.k;
+            return true;
+          },
+          nhi::EnergyLimit::relative_to_E0(nhi::EnergyLimit::Mode::kStop));
       char fate = 's';
-      const nhi::RunReport rep = nhi::run_method(sys, spec, q0, v0, h, steps, [&](const nhi::Sample<S::n, S::m>& smp) {
-        const double dE = std::abs(nhi::energy(sys, smp.q, smp.v) - E0);
-        if (!std::isfinite(dE) || !nhi::all_finite(smp.q)) {
-          fate = 'n';
-          return false;
-        }
-        max_dE = std::max(max_dE, dE);
-        taken = smp.k;
-        if (dE > scale) {
-          fate = 'e';
-          return false;
-        }
-        return true;
-      });
-      if (fate == 's' && !rep.ok) fate = rep.failure == nhi::FailureKind::kNonFinite ? 'n' : 'f';
+      if (rep.failure == nhi::FailureKind::kEnergy) {  // the point past the threshold counts
+        fate = 'e';
+        max_dE = std::max(max_dE, rep.energy_error_at_limit);
+        taken = rep.failure_step;
+      } else if (!rep.ok) {
+        fate = rep.failure == nhi::FailureKind::kNonFinite ? 'n' : 'f';
+      }
       if (rep_out) *rep_out = rep;
       return json::array({std::string(1, fate), max_dE / scale, taken});
     } else {

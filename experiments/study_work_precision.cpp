@@ -8,7 +8,8 @@
 // explicit embedded Runge-Kutta pairs a C++ user would reach for, Boost.Odeint's
 // runge_kutta_fehlberg78 and runge_kutta_dopri5 (controlled, atol = rtol = tol),
 // all on the same index-reduced ODE.  CPU time is per-thread time of a run
-// without diagnostics, repeated until 50 ms have accumulated (for fixed-step
+// without diagnostics, repeated until 50 ms have accumulated, the median of
+// three such timings with their range (for fixed-step
 // methods, the T = 10^4 cost is the T = 100 cost times 100; for CVODE the
 // diagnosed T = 10^4 run itself when it takes >= 0.5 s, its observer (~1e5
 // energies, a few ms) then under 1 % of it; over T = 10^6 on the particle a fixed-step cost is
@@ -69,9 +70,10 @@ std::string tol_range(int tightest) {
 }
 
 template <class S>
-using State = std::array<double, 2 * S::n>;
+using State = nhi::OdeState<S>;
 
-// Adaptive Boost.Odeint run on (q, v); obs(t, q, v) at every accepted step.
+// Adaptive Boost.Odeint run on (q, v) with the library's right-hand side
+// (embedded_rk.hpp); obs(t, q, v) at every accepted step.
 template <class S, class Stepper, class Obs>
 long odeint_run(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T, double tol,
                 Obs&& obs) {
@@ -82,21 +84,13 @@ long odeint_run(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::
     x[n + i] = v0[i];
   }
   long rhs = 0;
-  auto f = [&](const State<S>& y, State<S>& dy, double) {
-    ++rhs;
-    const Vec<double, n> q = Eigen::Map<const Vec<double, n>>(y.data());
-    const Vec<double, n> v = Eigen::Map<const Vec<double, n>>(y.data() + n);
-    const Vec<double, n> a = sys.acceleration(q, v);
-    for (int i = 0; i < n; ++i) {
-      dy[i] = v[i];
-      dy[n + i] = a[i];
-    }
-  };
+  const nhi::OdeRhs<S> f{&sys, &rhs};
   auto o = [&](const State<S>& y, double t) {
     obs(t, Vec<double, n>(Eigen::Map<const Vec<double, n>>(y.data())),
         Vec<double, n>(Eigen::Map<const Vec<double, n>>(y.data() + n)));
   };
-  odeint::integrate_adaptive(odeint::make_controlled<Stepper>(tol, tol), f, x, 0.0, T, 0.01, o);
+  odeint::integrate_adaptive(odeint::make_controlled<Stepper>(tol, tol), f, x, 0.0, T, nhi::EmbeddedRkOptions{}.first_step,
+                             o);
   return rhs;
 }
 
@@ -115,62 +109,88 @@ bool long_run(const S& sys, const Config& c) {
   return t.preserves_energy ? c.param >= 0.4 * (1 - 1e-12) : c.param >= 0.1 * (1 - 1e-12);
 }
 
-// The library methods (and the reference solution) run through run_method.
+// The energy limit of every run here (the runs' guard, guard.hpp): a run whose
+// |E - E0| passes max(|E0|, 1) is stopped there and failed (it can meet none
+// of the targets, <= 1e-2): on a non-conservative method the energy can then
+// grow without bound and the adaptive step shrink with it (dopri5 at tol 1e-3
+// on contact_oscillator: E = 1e19 by t = 5500 after 3e7 steps), so the run
+// would not end.
+const nhi::EnergyLimit kLimit = nhi::EnergyLimit::runner_default();
+
+// The library methods run through run_method: the adaptive ones at
+// tolerance param, the reference solution output every 0.1, an adaptive pair
+// over one output interval T.
 template <class S, class Sampler>
 bool run_library(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T,
-                 Sampler&& sample) {
+                 Sampler&& sample, bool guard) {
   const nhi::StudyMethod& m = c.method;
-  if (m.spec.kind == "benchmark") {  // the reference solution at tolerance param, output every 0.1
+  const nhi::EnergyLimit limit = guard ? kLimit : nhi::EnergyLimit::off();
+  if (m.spec.kind == "benchmark" || m.external) {
     nhi::MethodSpec spec = m.spec;
     spec.tolerance = c.param;
-    const double out = 0.1;
-    return nhi::run_method(sys, spec, q0, v0, out, std::lround(T / out), sample).ok;
+    const double out = m.external ? T : 0.1;
+    return nhi::run_method(sys, spec, q0, v0, out, std::lround(T / out), sample, limit).ok;
   }
-  return nhi::run_method(sys, m.spec, q0, v0, c.param, std::lround(T / c.param), sample).ok;
+  return nhi::run_method(sys, m.spec, q0, v0, c.param, std::lround(T / c.param), sample, limit).ok;
 }
-
-// A run whose energy error passes max(|E0|, 1) is stopped there and failed
-// (it can meet none of the targets, <= 1e-2): on a non-conservative method
-// the energy can then grow without bound and the adaptive step shrink with
-// it (dopri5 at tol 1e-3 on contact_oscillator: E = 1e19 by t = 5500 after
-// 3e7 steps), so the run would not end.
-struct Runaway {};
 
 // Run method `c` to T; obs(t, q, v) sees the trajectory (every step, or every
 // accepted/output step for adaptive methods).  Returns false on failure; with
-// `guard` also when the energy runs away (see Runaway; the timed runs have no
-// guard and run only configurations whose guarded run succeeded).
-// With `rhs`, an external pair's run counts its right-hand-side evaluations
-// there (rejected steps included).
+// `guard` also when the energy passes kLimit (the timed runs have no guard and
+// run only configurations whose guarded run succeeded).  An adaptive pair runs
+// through Boost.Odeint's loop here, observed at every accepted step (the
+// energy runs), or with `whole` as the library method over one output
+// interval T (the final-error run: `nhi run` with h = T, steps = 1, gives the
+// same q(T)).  With `rhs`, an external pair's run counts its right-hand-side
+// evaluations there (rejected steps included).
 template <class S, class Obs>
 bool run(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T, Obs&& obs,
-         bool guard = false, long* rhs = nullptr) {
-  const double E0 = nhi::energy(sys, q0, v0), bound = std::max(std::abs(E0), 1.0);
-  auto checked = [&](double t, const Vec<double, S::n>& q, const Vec<double, S::n>& v) {
-    if (guard && !(std::abs(nhi::energy(sys, q, v) - E0) <= bound)) throw Runaway{};
-    obs(t, q, v);
-  };
+         bool guard = false, long* rhs = nullptr, bool whole = false) {
   auto sample = [&](const nhi::Sample<S::n, S::m>& s) {
-    checked(s.t, s.q, s.v);
+    obs(s.t, s.q, s.v);
     return true;
   };
   const nhi::StudyMethod& m = c.method;
-  try {
-    if (m.external) {
+  if (m.external && !whole) {
+    struct Runaway {};
+    const double E0 = nhi::energy(sys, q0, v0);
+    auto checked = [&](double t, const Vec<double, S::n>& q, const Vec<double, S::n>& v) {
+      if (guard && kLimit.exceeded(std::abs(nhi::energy(sys, q, v) - E0), E0)) throw Runaway{};
+      obs(t, q, v);
+    };
+    try {
       const long f = m.external_label == "rkf78"
                          ? odeint_run<S, odeint::runge_kutta_fehlberg78<State<S>>>(sys, q0, v0, T, c.param, checked)
                          : odeint_run<S, odeint::runge_kutta_dopri5<State<S>>>(sys, q0, v0, T, c.param, checked);
       if (rhs) *rhs = f;
       return true;
+    } catch (const Runaway&) {
+      return false;
     }
-    return run_library(sys, c, q0, v0, T, sample);
-  } catch (const Runaway&) {
-    return false;
   }
+  return run_library(sys, c, q0, v0, T, sample, guard);
 }
 
+// A CPU time: the median of kRepetitions timings and their range (the
+// decision tables call two methods a tie where their ranges overlap).
+constexpr int kRepetitions = 3;
+struct Timing {
+  double median = 0, lo = 0, hi = 0;
+  Timing scaled(double f) const { return {median * f, lo * f, hi * f}; }
+};
+Timing timing_of(std::vector<double> t) {
+  std::sort(t.begin(), t.end());
+  return {t[t.size() / 2], t.front(), t.back()};
+}
+void put(json* row, const std::string& key, const Timing& t) {
+  (*row)[key] = t.median;
+  (*row)[key + "_range"] = {t.lo, t.hi};
+}
+
+// One timing: CPU seconds per run of a run without diagnostics, averaged over
+// repeats totalling >= 50 ms.
 template <class S>
-double cpu_per_run(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T) {
+double cpu_once(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T) {
   long reps = 0;
   const double t0 = study::thread_cpu_seconds();
   double t = t0;
@@ -182,6 +202,16 @@ double cpu_per_run(const S& sys, const Config& c, const Vec<double, S::n>& q0, c
     t = study::thread_cpu_seconds();
   } while (t - t0 < 0.05 && reps < 1000);
   return (t - t0) / reps;
+}
+
+// kRepetitions timings, the first one `first` when given (a run already timed).
+template <class S>
+Timing cpu_per_run(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0, double T,
+                   double first = -1) {
+  std::vector<double> t;
+  if (first >= 0) t.push_back(first);
+  while (int(t.size()) < kRepetitions) t.push_back(cpu_once(sys, c, q0, v0, T));
+  return timing_of(t);
 }
 
 }  // namespace
@@ -223,10 +253,11 @@ int main(int argc, char** argv) {
                    {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
                                       tol_range(kTightestTolPairs) + " (the explicit pairs)"},
                    {"cpu",
-                    "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms; "
+                    "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms, "
+                    "the median of 3 such timings (each cpu_* has its range [min, max] of the 3 in cpu_*_range); "
                     "for fixed-step methods cpu_energy is cpu_energy_short times T_energy / T_energy_short (the same "
-                    "steps, 100 times as many); for the reference solution (CVODE, output every 0.1) cpu_energy is the "
-                    "CPU time of the diagnosed run itself when that took >= 0.5 s"},
+                    "steps, 100 times as many); for the reference solution (CVODE, output every 0.1) the diagnosed run "
+                    "itself is the first of the 3 timings of cpu_energy when it took >= 0.5 s"},
                    {"energy_error",
                     "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output "
                     "point every 0.1 (CVODE)"},
@@ -269,12 +300,17 @@ int main(int argc, char** argv) {
       };
       cells.run = [&](size_t i) {
         const Config& c = configs[i];
+        const bool adaptive = c.method.external || c.method.spec.kind == "benchmark";
+        char param[32];
+        std::snprintf(param, sizeof param, "%g", c.param);
         json row = {{"label", c.method.label()},
-                    {"adaptive", c.method.external || c.method.spec.kind == "benchmark"},
+                    {"keys", c.method.spec.scene_keys() + (adaptive ? " tolerance=" : " h=") + param},
+                    {"adaptive", adaptive},
                     {"param", c.param}};
         Vec<double, n> qT = q0;
         const bool ok1 = run(
-            sys, c, q0, v0, kT_final, [&](double, const Vec<double, n>& q, const Vec<double, n>&) { qT = q; }, true);
+            sys, c, q0, v0, kT_final, [&](double, const Vec<double, n>& q, const Vec<double, n>&) { qT = q; }, true,
+            nullptr, true);
         double maxE = 0, maxE_short = 0, t_end = 0;
         Vec<double, n> q_end = q0, v_end = v0;
         long rhs_energy = 0, rhs_long = 0;  // right-hand sides of an external pair's runs
@@ -300,20 +336,20 @@ int main(int argc, char** argv) {
                            ": step failure, or |E - E0| above max(|E0|, 1) (the energy ran away)";
           return row;
         }
-        row["cpu_final"] = cpu_per_run(sys, c, q0, v0, kT_final);
-        const double cpu_short = cpu_per_run(sys, c, q0, v0, kT_energy_short);
-        row["cpu_energy_short"] = cpu_short;
+        put(&row, "cpu_final", cpu_per_run(sys, c, q0, v0, kT_final));
+        const Timing cpu_short = cpu_per_run(sys, c, q0, v0, kT_energy_short);
+        put(&row, "cpu_energy_short", cpu_short);
         // A fixed-step run costs its number of steps times the cost of a step,
         // so its T_energy cost is the T_energy_short cost scaled by the ratio of
         // steps (measured, repeated to >= 50 ms); an adaptive run is timed whole.
-        // The reference solution's diagnosed run is its own timing when it
+        // The reference solution's diagnosed run is its first timing when it
         // took >= kSelfTimed: its observer sees one point per 0.1 time units
-        // (~1e5 energies, a few ms: under 1 % of such a run), and timed
-        // reruns would add a large share of the study's CPU time.
+        // (~1e5 energies, a few ms: under 1 % of such a run).
         const bool self_timed = c.method.spec.kind == "benchmark" && cpu_diagnosed >= kSelfTimed;
-        row["cpu_energy"] = self_timed                    ? cpu_diagnosed
-                            : row["adaptive"].get<bool>() ? cpu_per_run(sys, c, q0, v0, kT_energy)
-                                                          : cpu_short * (kT_energy / kT_energy_short);
+        const Timing cpu_energy = row["adaptive"].get<bool>()
+                                      ? cpu_per_run(sys, c, q0, v0, kT_energy, self_timed ? cpu_diagnosed : -1)
+                                      : cpu_short.scaled(kT_energy / kT_energy_short);
+        put(&row, "cpu_energy", cpu_energy);
         if (long_scene && long_run(sys, c)) {
           double maxE_long = 0;
           const bool ok3 = run(
@@ -327,9 +363,9 @@ int main(int argc, char** argv) {
             // external pair (the only adaptive methods run to T_long) by its
             // right-hand-side evaluations, counted in the two runs; a timed
             // rerun of the pairs to 10^6 would double the particle's cost.
-            row["cpu_energy_long"] = c.method.external
-                                         ? row["cpu_energy"].get<double>() * (double(rhs_long) / double(rhs_energy))
-                                         : cpu_short * (kT_long / kT_energy_short);
+            put(&row, "cpu_energy_long",
+                c.method.external ? cpu_energy.scaled(double(rhs_long) / double(rhs_energy))
+                                  : cpu_short.scaled(kT_long / kT_energy_short));
             row["max_energy_error_long"] = maxE_long;
           } else {  // not ranked at T_long (summarize.sh needs max_energy_error_long)
             row["status_long"] = "failed";

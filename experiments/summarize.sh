@@ -186,17 +186,21 @@ echo
 WP='
 def extrap: .max_energy_error * ([1, .max_energy_error / ([.max_energy_error_short, 1e-300] | max)] | max);
 def horizon($h; $measured):
-  if $h == "1e2" then {err: .max_energy_error_short, cpu: .cpu_energy_short}
-  elif $h == "1e4" then {err: .max_energy_error, cpu: .cpu_energy}
-  elif $measured then {err: .max_energy_error_long, cpu: .cpu_energy_long}
-  else {err: extrap, cpu: (.cpu_energy * 100)} end;
+  if $h == "1e2" then {err: .max_energy_error_short, cpu: .cpu_energy_short, range: .cpu_energy_short_range}
+  elif $h == "1e4" then {err: .max_energy_error, cpu: .cpu_energy, range: .cpu_energy_range}
+  elif $measured then {err: .max_energy_error_long, cpu: .cpu_energy_long, range: .cpu_energy_long_range}
+  else {err: extrap, cpu: (.cpu_energy * 100), range: (.cpu_energy_range | map(. * 100))} end;
+# Two entries of best() tie when their CPU ranges (min, max of the timings) overlap.
+def tie($a; $b): $b.range[0] <= $a.range[1];
+# The scene keys of an entry without its h or tolerance.
+def method_keys: .keys | sub(" (h|tolerance)=[^ ]*$"; "");
 def measured_long: [.runs[] | select(.status == "ok" and .max_energy_error_long != null)] | length > 0;
 # input: one scene of work_precision.json; output: [{label, param, err, cpu}], one per
 # method that keeps the error below $tol over $h, fastest first.
 def best($h; $tol):
   measured_long as $measured |
   [.runs[] | select(.status == "ok") | select($h != "1e6" or ($measured | not) or .max_energy_error_long != null)
-   | {label: .label, param: .param} + horizon($h; $measured) | select(.err != null and .err <= $tol)]
+   | {label: .label, param: .param, keys: .keys} + horizon($h; $measured) | select(.err != null and .err <= $tol)]
   | group_by(.label) | map(min_by(.cpu)) | sort_by(.cpu);
 def horizons: "1e2", "1e4", "1e6";
 def targets: 1e-2, 1e-4, 1e-6, 1e-8;
@@ -231,7 +235,10 @@ def class_rows: .scenes as $S | classes[] |
    measured: ([$cells[] | select(.extrap | not) | .scene] | unique),
    rank: ([$common[] as $m |
      {label: $m,
+      keys: ($cells[0].best[$m] | method_keys),
       score: ([range(0; $cells | length) as $i | $cells[$i].best[$m].cpu / $fastest[$i]] | geomean),
+      score_range: [([range(0; $cells | length) as $i | $cells[$i].best[$m].range[0] / $fastest[$i]] | geomean),
+                    ([range(0; $cells | length) as $i | $cells[$i].best[$m].range[1] / $fastest[$i]] | geomean)],
       wins: ([range(0; $cells | length) as $i | select($cells[$i].best[$m].cpu == $fastest[$i])] | length),
       params: [$cells[].best[$m].param]}] | sort_by(.score))};
 '
@@ -255,7 +262,7 @@ echo -n "Classes: "
 jq -r "$CLS"'classes | map("\(.name) (\(.scenes | join(", ")))") | join("; ") + "."' \
   --argjson classes "$CLASSES" "$R/work_precision.json"
 echo
-echo "| scene class | T | targets | method (h or tol) | fastest in | runner-up | x | best classical | x |"
+echo "| scene class | T | targets | method: scene keys, h or tolerance | fastest in | runner-up | x | best classical | x |"
 echo "|---|---|---|---|---|---|---|---|---|"
 jq -r "$G$WP$CLASSICAL$CLS"'
   def span: unique | if length > 1 then "\(first | g) to \(last | g)" else (.[0] | g) end;
@@ -266,8 +273,8 @@ jq -r "$G$WP$CLASSICAL$CLS"'
   "| \(.class) | \(.h)\($tag) | \(.band | map(g) | join(", ")) | " +
   (if ($rank | length) == 0 then "none reaches every target | - | - | - | - | -"
    else $rank[0] as $b |
-     "\($b.label) (\($b.params | span)) | \($b.wins) of \(.n) | " +
-     (if ($rank | length) > 1 then "\($rank[1].label) | \($rank[1].score / $b.score | g)" else "- | -" end) + " | " +
+     "\($b.label): `\($b.keys)` \(if ($b.keys | test("benchmark|rkf78|dopri5")) then "tolerance" else "h" end) \($b.params | span) | \($b.wins) of \(.n) | " +
+     (if ($rank | length) > 1 then "\($rank[1].label)\(if $rank[1].score_range[0] <= $b.score_range[1] then " (tie)" else "" end) | \($rank[1].score / $b.score | g)" else "- | -" end) + " | " +
      (if $rk == null then "none | -" else "\($rk.label) | \($rk.score / $b.score | g)" end) end) + " |"' \
   --argjson classes "$CLASSES" "$R/work_precision.json"
 echo
@@ -282,7 +289,7 @@ echo "runs that long (config.long_scenes; only the configurations it runs there 
 echo "extrapolated on the others: error(1e6) = error(1e4) * max(1, error(1e4)/error(1e2)) (the"
 echo "measured growth continued as a power law), CPU(1e6) = 100 CPU(1e4)."
 echo
-echo "| scene | T | target | fastest (h or tol) | CPU s | runner-up | x slower | best classical | x slower |"
+echo "| scene | T | target | fastest: scene keys | CPU s | runner-up | x slower | best classical | x slower |"
 echo "|---|---|---|---|---|---|---|---|---|"
 jq -r "$G$WP$CLASSICAL"'
   .scenes | to_entries[] | .key as $s | .value as $scene |
@@ -292,7 +299,7 @@ jq -r "$G$WP$CLASSICAL"'
   ($scene | best($h; $tol)) as $best |
   ([$best[] | select(.label | classical)][0]) as $rk |
   if ($best | length) == 0 then "| \($s) | \($h)\($tag) | \($tol | g) | none reaches it | - | - | - | - | - |"
-  else "| \($s) | \($h)\($tag) | \($tol | g) | \($best[0].label) (\($best[0].param | g)) | \($best[0].cpu | g) | \(if ($best | length) > 1 then $best[1].label else "-" end) | \(if ($best | length) > 1 then ($best[1].cpu / $best[0].cpu | g) else "-" end) | \(if $rk then $rk.label else "none" end) | \(if $rk then ($rk.cpu / $best[0].cpu | g) else "-" end) |" end' "$R/work_precision.json"
+  else "| \($s) | \($h)\($tag) | \($tol | g) | \($best[0].label): `\($best[0].keys)` | \($best[0].cpu | g) | \(if ($best | length) > 1 then $best[1].label + (if tie($best[0]; $best[1]) then " (tie)" else "" end) else "-" end) | \(if ($best | length) > 1 then ($best[1].cpu / $best[0].cpu | g) else "-" end) | \(if $rk then $rk.label else "none" end) | \(if $rk then ($rk.cpu / $best[0].cpu | g) else "-" end) |" end' "$R/work_precision.json"
 
 # ---- SPARK against mp06's compositions (study_work_precision) ------------
 echo "## SPARK against mp06's compositions at equal error (results/work_precision.json)"

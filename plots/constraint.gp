@@ -17,28 +17,35 @@ load jq_script(sprintf("-n --argjson m %d", m), \
   '    | jq_block("$dla_discrete_\($a + 1)"; [.t, (.discrete_constraint | map(.[$a] | fabs))] | transpose[]))), ' . \
   '"jq_ok = 1"', sprintf("%s %s %s", dla, rk4, ref))
 if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s_*.json, no figure drawn", out, stem) }
+H = 330 * (m + 1) + 90
+set terminal pngcairo size 1000,H enhanced font "DejaVu Sans,11" linewidth 1.2
 set output out
-set terminal pngcairo size 1000,(350 * (m + 1))
-set multiplot layout (m + 1),1 title label.", constraint values (h = 0.2)"
-set xlabel "t"
+set multiplot title label.", constraint values (h = 0.2)"
+set xlabel "t".U
+# One legend for all panels, above them (never on the data); the reference first.
+TOP = 1 - 125.0 / H
+GAP = 120.0 / H
+set key at screen 0.5, 1 - 40.0 / H center top horizontal maxcols 2 Left reverse font ",10" samplen 3 width 2 nobox noopaque
+eval stack(1, m + 1, TOP, 60.0 / H, GAP)
 set xrange [0:40]
 set title "signed {/Symbol w}_1(q) v, first 40 time units"
-set ylabel "{/Symbol w}_1(q) v"
-set key top left box opaque
-plot $dla_signed u 1:2 w l ls 1 t "DLA, {/Symbol a} = 1/2", \
-     $rk4_signed u 1:2 w l ls 2 t "RK4", \
-     $ref_signed u 1:2 w l ls 3 t "benchmark"
+set ylabel "{/Symbol w}_1(q) v".U
+plot $ref_signed u 1:2 w l ls method_ls("reference") t "reference (CVODE Adams)", \
+     $dla_signed u 1:2 w l ls method_ls("dla a=0.5") t "DLA, {/Symbol a} = 1/2", \
+     $rk4_signed u 1:2 w l ls method_ls("rk4") t "RK4", \
+     keyentry w p pt 7 ps 0.8 lc rgb "#003D66" t "DLA: its discrete constraint {/Symbol w}_d(q_k, q_{k+1})"
+unset key
 set autoscale x
 set logscale y
 set format y "10^{%L}"
 set yrange [1e-18:10]
-set key tmargin center horizontal maxrows 2 noopaque nobox
 do for [a = 0:m-1] {
+  eval stack(a + 2, m + 1, TOP, 60.0 / H, GAP)
   set title sprintf("|{/Symbol w}_%d(q) v|, whole run (log scale)", a + 1)
-  set ylabel sprintf("|{/Symbol w}_%d(q) v|", a + 1)
-  plot sprintf("$dla_%d", a + 1) u 1:2 w l ls 1 t "DLA, {/Symbol a} = 1/2", \
-       sprintf("$rk4_%d", a + 1) u 1:2 w l ls 2 t "RK4", \
-       sprintf("$ref_%d", a + 1) u 1:2 w l ls 3 t "benchmark", \
-       sprintf("$dla_discrete_%d", a + 1) u 1:2 w p pt 7 ps 0.2 lc rgb "#17becf" t "DLA: its discrete constraint {/Symbol w}_d(q_k, q_{k+1})"
+  set ylabel sprintf("|{/Symbol w}_%d(q) v|", a + 1).U
+  plot sprintf("$ref_%d", a + 1) u 1:2 w l ls method_ls("reference"), \
+       sprintf("$dla_%d", a + 1) u 1:2 w l ls method_ls("dla a=0.5"), \
+       sprintf("$rk4_%d", a + 1) u 1:2 w l ls method_ls("rk4"), \
+       sprintf("$dla_discrete_%d", a + 1) u 1:2 w p pt 7 ps 0.2 lc rgb "#003D66"
 }
 unset multiplot

@@ -12,16 +12,22 @@ load jq_script("-n", \
   '(("dla", "rk4", "ref") as $name | input | jq_block("$\($name)"; [.t, .energy] | transpose[])), ' . \
   '"jq_ok = 1"', sprintf("%s %s %s", dla, rk4, ref))
 if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s_*.json, no figure drawn", out, stem) }
+set terminal pngcairo size 1000,760 enhanced font "DejaVu Sans,11" linewidth 1.2
 set output out
-set multiplot layout 2,1 title label.", energy (h = 0.2)"
-set xlabel "t"
-set ylabel "E"
-set key bottom left
-plot $dla u 1:2 w l ls 1 t "DLA, {/Symbol a} = 1/2", \
-     $rk4 u 1:2 w l ls 2 t "RK4", \
-     $ref u 1:2 w l ls 3 t "benchmark (CVODE Adams, tol 1e-12)"
+set multiplot title label.", energy (h = 0.2)"
+set xlabel "t".U
+set ylabel "E".U
+# One legend for both panels, above them (never on the data); the reference first.
+set key at screen 0.5, 0.935 center top horizontal maxcols 3 Left reverse font ",10" samplen 3 width 2 nobox noopaque
+P = '$ref u 1:2 w l ls method_ls("reference") t "reference (CVODE Adams, tol 1e-12)", ' . \
+    '$dla u 1:2 w l ls method_ls("dla a=0.5") t "DLA, {/Symbol a} = 1/2", ' . \
+    '$rk4 u 1:2 w l ls method_ls("rk4") t "RK4"'
+eval stack(1, 2, 0.84, 0.08, 0.15)
+set title "whole run"
+plot @P
+unset key
+eval stack(2, 2, 0.84, 0.08, 0.15)
 set xrange [0:40]
 set title "first 40 time units"
-set key bottom right horizontal
-replot
+plot @P
 unset multiplot

@@ -17,18 +17,24 @@ load jq_script("-n", \
   'jq_block("$ref"; $ref | e), (("dla", "mp", "mptj", "rk4") as $name | input | jq_block("$\($name)"; e)), ' . \
   '"jq_ok = 1"', sprintf("%s %s %s %s %s", ref, dla, mp, mptj, rk4))
 if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s_*.json, no figure drawn", out, stem) }
+set terminal pngcairo size 1000,780 enhanced font "DejaVu Sans,11" linewidth 1.2
 set output out
-set multiplot layout 2,1 title label.", energy E - E_0 (h = 0.2), methods after the paper"
-set xlabel "t"
-set ylabel "E - E_0"
-set key bottom left
-plot $dla u 1:2 w l ls method_ls("dla a=0.5") t "DLA, {/Symbol a} = 1/2", \
-     $mp u 1:2 w l ls method_ls("mp06") t "mp06", \
-     $mptj u 1:2 w l ls method_ls("mp06+triple_jump") t "mp06, triple jump (order 4)", \
-     $rk4 u 1:2 w l ls method_ls("rk4") t "RK4", \
-     $ref u 1:2 w l ls method_ls("reference") t "reference (CVODE Adams, tol 1e-12)"
+set multiplot title label.", energy E − E_0 (h = 0.2), methods after the paper"
+set xlabel "t".U
+set ylabel "E − E_0".U
+# One legend for both panels, above them (never on the data); the reference first.
+set key at screen 0.5, 0.935 center top horizontal maxcols 3 Left reverse font ",10" samplen 3 width 2 nobox noopaque
+P = '$ref u 1:2 w l ls method_ls("reference") t "reference (CVODE Adams, tol 1e-12)", ' . \
+    '$dla u 1:2 w l ls method_ls("dla a=0.5") t "DLA, {/Symbol a} = 1/2", ' . \
+    '$mp u 1:2 w l ls method_ls("mp06") t "mp06", ' . \
+    '$mptj u 1:2 w l ls method_ls("mp06+triple_jump") t "mp06, triple jump (order 4)", ' . \
+    '$rk4 u 1:2 w l ls method_ls("rk4") t "RK4"'
+eval stack(1, 2, 0.81, 0.08, 0.15)
+set title "whole run"
+plot @P
+unset key
+eval stack(2, 2, 0.81, 0.08, 0.15)
 set xrange [0:40]
 set title "first 40 time units"
-set key bottom right horizontal maxrows 2
-replot
+plot @P
 unset multiplot

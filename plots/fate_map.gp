@@ -28,7 +28,7 @@ hmin = system(sprintf("jq '.config.h[0] | log10' %s", file)) + 0
 hmax = system(sprintf("jq '.config.h[-1] | log10' %s", file)) + 0
 dh = (hmax - hmin) / (int(system(sprintf("jq '.config.h | length' %s", file))) - 1)
 set xrange [hmin - dh/2 : hmax + dh/2]
-set xlabel "h"
+set xlabel "h".U
 set xtics ("0.05" log10(0.05), "0.1" -1, "0.2" log10(0.2), "0.5" log10(0.5), "1" 0, "2" log10(2), "5" log10(5))
 set multiplot layout 2,(V+1)/2 title sprintf("Fate map of %s: %d initial states, T = %s, per method and h; black: largest h with every run stable", scene, states, T) noenhanced
 do for [e=0:V-1] {

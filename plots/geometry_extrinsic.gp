@@ -4,7 +4,7 @@
 # the eq.-17 DLA.
 # Called as gnuplot -e "file='results/geometry.json'; out='plots/geometry_extrinsic.png'" plots/geometry_extrinsic.gp
 load "plots/style.gp"
-set terminal pngcairo size 1500,520 enhanced font "DejaVu Sans,10" linewidth 1.2
+set terminal pngcairo size 1500,600 enhanced font "DejaVu Sans,11" linewidth 1.2
 # Everything the figure needs, from one jq pass (jq_script, plots/style.gp):
 #   oi, oe, the fitted orders of the intrinsic and extrinsic DLA;
 #   $robot_intrinsic, $robot_extrinsic: t and E - E_0 of the robot's runs;
@@ -20,29 +20,39 @@ load jq_script("", \
 if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s, no figure drawn", out, file) }
 set output out
 set style data lines
-set multiplot layout 1,3 title "Extrinsic (unit vectors, eq. 17) against intrinsic (angles) DLA, midpoint"
-set title "robot, h = 0.2: E - E_0"
-set xlabel "t"
+# Intrinsic and omega-DLA: the DLA's style; extrinsic and eq.-17 DLA: dark dashed.
+DLA = method_ls("dla a=0.5")
+ALT = 'lc rgb "#003D66" dt (14,7) lw 1.5'
+set multiplot title "Extrinsic (unit vectors, eq. 17) against intrinsic (angles) DLA, midpoint"
+set key Left reverse font ",10" samplen 3.5 nobox noopaque
+eval side(1, 3, 0.84, 0.27)
+set title "robot, h = 0.2"
+set xlabel "t".U
+set ylabel "E − E_0".U
 set xrange [0:30]
-set key bottom right font ",8"
-plot $robot_intrinsic u 1:2 ls 1 t "intrinsic (angles)", \
-     $robot_extrinsic u 1:2 lc rgb "#ff7f0e" t "extrinsic (unit vectors)"
-set title "robot: max-norm error of q(T = 2) against the exact reduced flow"
-set xlabel "h"
+set key at screen 0.075, 0.14 left top
+plot $robot_intrinsic u 1:2 ls DLA t "intrinsic (angles)", \
+     $robot_extrinsic u 1:2 @ALT t "extrinsic (unit vectors)"
+eval side(2, 3, 0.84, 0.27)
+set title "robot: error of q(T = 2) against the exact reduced flow"
+set xlabel "h".U
+set ylabel "max-norm error of q(T = 2)".U
 set xrange [*:*]
 set logscale xy
 set format x "10^{%L}"
 set format y "10^{%L}"
-set key top left font ",8"
-plot $conv_intrinsic u 1:2 w lp ls 1 pt 7 t sprintf("intrinsic, order %.2f", oi), \
-     $conv_extrinsic u 1:2 w lp lc rgb "#ff7f0e" pt 5 t sprintf("extrinsic, order %.2f", oe)
+set key at screen 0.395, 0.14 left top
+plot $conv_intrinsic u 1:2 w lp ls DLA pt 7 t sprintf("intrinsic, order %.2f", oi), \
+     $conv_extrinsic u 1:2 w lp @ALT pt 5 t sprintf("extrinsic, order %.2f", oe)
 unset logscale
 set format x "%g"
 set format y "%g"
-set title "circle (Remark 3.3), h = 0.1: E - E_0"
-set xlabel "t"
+eval side(3, 3, 0.84, 0.27)
+set title "circle (Remark 3.3), h = 0.1"
+set xlabel "t".U
+set ylabel "E − E_0".U
 set xrange [0:100]
-set key bottom right font ",8"
-plot $circle_omega u 1:2 ls 1 lw 2.5 t "DLA with {/Symbol w} = q^T", \
-     $circle_g u 1:2 lc rgb "black" dt 2 t "DLA with g = (|q|^2 - 1)/2 (eq. 17)"
+set key at screen 0.715, 0.14 left top
+plot $circle_omega u 1:2 ls DLA lw 3 t "DLA with {/Symbol w} = q^T", \
+     $circle_g u 1:2 lc rgb "black" dt (14,7) lw 1.2 t "DLA with g = (|q|^2 − 1)/2 (eq. 17)"
 unset multiplot

@@ -14,15 +14,19 @@ load jq_script(sprintf("--arg scene '%s'", scene), \
   '   jq_block("$ERR\($i)"; [.t, .error] | transpose[] | select(.[1] > 0))), ' . \
   '"jq_ok = 1"', file)
 if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s, no figure drawn", out, file) }
+eval SORT_BY_STY  # ORD: the methods by family
 set key noenhanced  # method labels contain underscores
-set terminal pngcairo size 1000,700 enhanced font "DejaVu Sans,10" linewidth 1.2
+set terminal pngcairo size 1200,700 enhanced font "DejaVu Sans,11" linewidth 1.2
 set output out
 set datafile separator "\t"
 set logscale xy
 set format x "10^{%L}"
 set format y "10^{%L}"
-set xlabel "t"
-set ylabel "max_i |q_i(t) - q_{ref,i}(t)|"
-set key outside right font ",8" spacing 0.9
+set xlabel "t".U
+set ylabel "max_i |q_i(t) − q_{ref,i}(t)|".U
+set key outside right top vertical Left reverse font ",10" samplen 3.5 nobox noopaque
 set title sprintf("Global error, h = %s, T = %.4g (%s; reference: %s)", H, T, scene, REF) noenhanced
-plot for [i=0:N-1] sprintf("$ERR%d", i) u 1:2 w l ls STY[i + 1] t LABEL[i + 1]
+# Lines, their markers every 5 points staggered per method, one key entry each.
+plot for [k=1:N] sprintf("$ERR%d", ORD[k] - 1) u 1:2 w l ls STY[ORD[k]] notitle, \
+     for [k=1:N] sprintf("$ERR%d", ORD[k] - 1) every 5::(k % 5) u 1:2 w p ls STY[ORD[k]] notitle, \
+     for [k=1:N] keyentry w lp ls STY[ORD[k]] t LABEL[ORD[k]]

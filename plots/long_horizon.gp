@@ -27,37 +27,63 @@ load jq_script(sprintf("--arg scene '%s'", scene), \
   '      select(.group == "main") | [.t, .first_integrals[$w.value].max_abs_error] | transpose[] | select(.[1] > 0)))), ' . \
   '"jq_ok = 1"', file)
 if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s, no figure drawn", out, file) }
-label(i) = LABEL[i + 1]
-group(i) = GROUP[i + 1]
-sty(i) = STY[i + 1]
+eval SORT_BY_STY  # ORD: the methods by family, reference first
+label(i) = LABEL[i]
+group(i) = GROUP[i]
+sty(i) = STY[i]
+# Lines, then their markers every EV points (staggered per method, so that
+# markers of overlapping lines do not hide each other), drawn in the order ORD;
+# the legends come from keyentry lines, one per method of the group shown.
+EV = 26
 set key noenhanced  # method labels contain underscores
-set terminal pngcairo size 1500,800 enhanced font "DejaVu Sans,10" linewidth 1.2
+fi = strlen(FI) > 0
+set terminal pngcairo size 1500,(fi ? 1300 : 820) enhanced font "DejaVu Sans,11" linewidth 1.2
 set output out
 set logscale xy
 set format x "10^{%L}"
 set format y "10^{%L}"
-set xlabel "t"
-set key outside below font ",8" spacing 0.9 maxrows 6
+set xlabel "t".U
 set xrange [H:1.5*T]
-set style data lines
-if (strlen(FI) > 0) { set terminal pngcairo size 1500,1300 enhanced font "DejaVu Sans,10" linewidth 1.2; set output out }
-set multiplot layout (strlen(FI) > 0 ? 2 : 1),3 title sprintf("Long horizon, h = %s, 10^6 steps, T = %.4g (%s; the reference solution: %.0e steps)", H, T, scene, RS) noenhanced
-set title "max_{s <= t} |E - E_0|"
 set yrange [1e-17:1e3]
-plot for [i=0:N-1] sprintf("$E%d", i) u 1:2 ls sty(i) t (group(i) eq "main" ? label(i) : "")
-set title "max_{s <= t} max_a |{/Symbol w}_a(q) v|"
-set yrange [1e-17:1e3]
-plot for [i=0:N-1] sprintf("$C%d", i) u 1:2 ls sty(i) t (group(i) eq "main" ? label(i) : "")
-set title "variants (other alphas, more compositions): max_{s <= t} |E - E_0|"
+unset key
+# Panel p (1-based, three a row) at its place; the legends go below all panels.
+bot = fi ? 0.26 : 0.36
+row_h = fi ? 0.28 : 0.52
+panel(p) = sprintf("set lmargin at screen %g; set rmargin at screen %g; set tmargin at screen %g; set bmargin at screen %g", \
+  0.065 + ((p - 1) % 3) * 0.33, 0.065 + ((p - 1) % 3) * 0.33 + 0.255, \
+  bot + (fi ? 1 - int((p - 1) / 3) : 0) * (row_h + 0.085) + row_h, bot + (fi ? 1 - int((p - 1) / 3) : 0) * (row_h + 0.085))
+set multiplot title sprintf("Long horizon, h = %s, 10^6 steps, T = %.4g (%s; the reference solution: %.0e steps)", H, T, scene, RS) noenhanced
+eval panel(1)
+set title "main methods: energy"
+set ylabel "max_{s ≤ t} |E − E_0|".U
+set key at screen 0.02, bot - 0.09 left top vertical maxrows 11 Left reverse font ",9" samplen 3.5 nobox noopaque
+plot for [k=1:N] sprintf("$E%d", ORD[k] - 1) u 1:2 w l ls sty(ORD[k]) notitle, \
+     for [k=1:N] sprintf("$E%d", ORD[k] - 1) every EV::(3 * k % EV) u 1:2 w p ls sty(ORD[k]) notitle, \
+     for [k=1:N] keyentry w lp ls sty(ORD[k]) t (group(ORD[k]) eq "main" ? label(ORD[k]) : "")
+unset key
+eval panel(2)
+set title "main methods: constraint"
+set ylabel "max_{s ≤ t} max_a |{/Symbol w}_a(q) v|".U
+plot for [k=1:N] sprintf("$C%d", ORD[k] - 1) u 1:2 w l ls sty(ORD[k]), \
+     for [k=1:N] sprintf("$C%d", ORD[k] - 1) every EV::(3 * k % EV) u 1:2 w p ls sty(ORD[k])
+eval panel(3)
+set title "variants (other {/Symbol a}, compositions): energy"
+set ylabel "max_{s ≤ t} |E − E_0|".U
 set yrange [1e-12:1e6]
-set format y "10^{%L}"
-plot for [i=0:N-1] sprintf("$V%d", i) u 1:2 ls sty(i) t (group(i) eq "variant" ? label(i) : "")
-if (strlen(FI) > 0) {
+set key at screen 0.52, bot - 0.09 left top vertical maxrows 11 Left reverse font ",9" samplen 3.5 nobox noopaque
+plot for [k=1:N] sprintf("$V%d", ORD[k] - 1) u 1:2 w l ls sty(ORD[k]) notitle, \
+     for [k=1:N] sprintf("$V%d", ORD[k] - 1) every EV::(3 * k % EV) u 1:2 w p ls sty(ORD[k]) notitle, \
+     for [k=1:N] keyentry w lp ls sty(ORD[k]) t (group(ORD[k]) eq "variant" ? label(ORD[k]) : "")
+unset key
+if (fi) {
   set yrange [1e-17:1e3]
-  do for [k=1:words(FI)] {
-    w = word(FI, k)
-    set title sprintf("main methods: max_{s <= t} |%s - %s_0|", w, w) noenhanced
-    plot for [i=0:N-1] sprintf("$F%d_%d", i, k) u 1:2 ls sty(i) t (group(i) eq "main" ? label(i) : "")
+  do for [j=1:words(FI)] {
+    w = word(FI, j)
+    eval panel(3 + j)
+    set title sprintf("main methods: %s", w) noenhanced
+    set ylabel sprintf("max_{s ≤ t} |%s − {%s}_0|", w, w).U
+    plot for [k=1:N] sprintf("$F%d_%d", ORD[k] - 1, j) u 1:2 w l ls sty(ORD[k]), \
+         for [k=1:N] sprintf("$F%d_%d", ORD[k] - 1, j) every EV::(3 * k % EV) u 1:2 w p ls sty(ORD[k])
   }
 }
 unset multiplot

@@ -1,73 +1,114 @@
-# Shared look of every figure: one colour per method, everywhere.
+# Shared look of every figure: one hue per method family, everywhere.
 set terminal pngcairo size 1000,700 enhanced font "DejaVu Sans,11" linewidth 1.2
 set grid lc rgb "#dddddd"
 set key top left box opaque
-set style line 1 lc rgb "#1f77b4" lw 1.5   # DLA
-set style line 2 lc rgb "#d62728" lw 1.5   # RK4
-set style line 3 lc rgb "#2ca02c" lw 2.0   # benchmark (CVODE Adams)
-# One fixed colour and point type per method, everywhere, keyed by the
-# method's label (nhi::StudyMethod::label(), `nhi list`): method_ls(label) is
-# its line style.  A new method gets a line of its own here and moves no other
-# method's colour; a label not listed is drawn in grey (line style 40).
-set style line 11 lc rgb "#1f77b4" pt 7  lw 1.5
-set style line 12 lc rgb "#9467bd" pt 5  lw 1.5
-set style line 13 lc rgb "#17becf" pt 15 lw 1.5
-set style line 14 lc rgb "#d62728" pt 9  lw 1.5
-set style line 15 lc rgb "#2ca02c" pt 13 lw 1.5
-set style line 16 lc rgb "#ff7f0e" pt 11 lw 1.5
-set style line 17 lc rgb "#e6550d" pt 14 lw 1.5
-set style line 18 lc rgb "#fdae6b" pt 12 lw 1.5
-set style line 19 lc rgb "#a63603" pt 3  lw 1.5
-set style line 20 lc rgb "#8c564b" pt 6  lw 1.5
-set style line 21 lc rgb "#5a3a1a" pt 8  lw 1.5
-set style line 22 lc rgb "#c49c94" pt 4  lw 1.5
-set style line 23 lc rgb "#e377c2" pt 6  lw 1.5
-set style line 24 lc rgb "#bcbd22" pt 8  lw 1.5
-set style line 25 lc rgb "#393b79" pt 10 lw 1.5
-set style line 26 lc rgb "#ce6dbd" pt 12 lw 1.5
-set style line 27 lc rgb "#6baed6" pt 1  lw 1.5
-set style line 28 lc rgb "#d6a06b" pt 2  lw 1.5
-set style line 29 lc rgb "#7b4173" pt 3  lw 1.5
-set style line 30 lc rgb "#7f7f7f" pt 1  lw 1.5
-set style line 31 lc rgb "#000000" pt 2  lw 1.5
-set style line 32 lc rgb "#637939" pt 5  lw 1.5
-set style line 33 lc rgb "#8ca252" pt 7  lw 1.5
-set style line 34 lc rgb "#b5cf6b" pt 9  lw 1.5
-set style line 35 lc rgb "#843c39" pt 4  lw 1.5
-set style line 36 lc rgb "#ad494a" pt 6  lw 1.5
-set style line 37 lc rgb "#d6616b" pt 8  lw 1.5
-set style line 38 lc rgb "#e7969c" pt 10 lw 1.5
-set style line 40 lc rgb "#aaaaaa" pt 1  lw 1.0
+# Every scene is nondimensional: the axis labels say so (U, appended).
+U = " (dimensionless)"
+# Palette: Okabe & Ito's colour-blind-safe colours, one hue per method family
+#   reference (CVODE)   black    #000000
+#   DLA (the paper's)   blue     #0072B2  (other alphas: dark #003D66)
+#   mp06 (RATTLE-type)  vermil.  #D55E00
+#   discrete gradient   green    #009E73  (endpoint form: dark #005A42)
+#   SPARK               orange   #E69F00
+#   RK4                 purple   #CC79A7
+#   adaptive rkf78/dopri5 sky    #56B4E9
+# Members of a family differ by marker and dash: the base method solid with a
+# filled circle, +triple_jump dashed with a triangle, +suzuki5 dash-dot with a
+# diamond, +order6 dotted with a square; open markers for the variants (other
+# alphas, the endpoint discrete gradient).  Marker types 1-3 (+, x, *) are
+# left free: plots/stability.gp marks failed runs with them.
+DASH = "(14,7)"
+DOT = "(3,4)"
+DASHDOT = "(14,5,3,5)"
+LONG = "(30,8)"
+# One fixed style per method, everywhere, keyed by the method's label
+# (nhi::StudyMethod::label(), `nhi list`): method_ls(label) is its line style.
+# Styles are numbered by family (reference 10, DLA 11-19, mp06 21-24, discrete
+# gradient 31-38, SPARK 41-43, RK4 51, adaptive 61-62, the convergence study's
+# isolation runs 71-78), so that sorting by style (SORT_BY_STY) groups a legend
+# by family with the reference first.  A new method gets a line of its own in
+# its family's range; a label not listed is drawn in grey (line style 99).
+set style line 10 lc rgb "#000000" lw 2.0 dt 1 pt 7  ps 0.6
+set style line 11 lc rgb "#0072B2" lw 1.5 dt 1 pt 7  ps 0.8
+set style line 12 lc rgb "#0072B2" lw 1.5 dt @DASH pt 9  ps 0.9
+set style line 13 lc rgb "#0072B2" lw 1.5 dt @DASHDOT pt 5  ps 0.8
+set style line 14 lc rgb "#0072B2" lw 1.5 dt @DOT pt 11 ps 0.9
+set style line 15 lc rgb "#003D66" lw 1.5 dt 1 pt 6  ps 0.8
+set style line 16 lc rgb "#003D66" lw 1.5 dt @DASH pt 8  ps 0.9
+set style line 17 lc rgb "#003D66" lw 1.5 dt @DOT pt 12 ps 0.9
+set style line 18 lc rgb "#003D66" lw 1.5 dt @LONG pt 10 ps 0.9
+set style line 19 lc rgb "#003D66" lw 1.5 dt @DASHDOT pt 4  ps 0.8
+set style line 21 lc rgb "#D55E00" lw 1.5 dt 1 pt 7  ps 0.8
+set style line 22 lc rgb "#D55E00" lw 1.5 dt @DASH pt 9  ps 0.9
+set style line 23 lc rgb "#D55E00" lw 1.5 dt @DASHDOT pt 13 ps 0.9
+set style line 24 lc rgb "#D55E00" lw 1.5 dt @DOT pt 5  ps 0.8
+set style line 31 lc rgb "#009E73" lw 1.5 dt 1 pt 7  ps 0.8
+set style line 32 lc rgb "#009E73" lw 1.5 dt @DASH pt 9  ps 0.9
+set style line 33 lc rgb "#009E73" lw 1.5 dt @DASHDOT pt 13 ps 0.9
+set style line 34 lc rgb "#009E73" lw 1.5 dt @DOT pt 5  ps 0.8
+set style line 35 lc rgb "#005A42" lw 1.5 dt 1 pt 6  ps 0.8
+set style line 36 lc rgb "#005A42" lw 1.5 dt @DASH pt 8  ps 0.9
+set style line 37 lc rgb "#005A42" lw 1.5 dt @DASHDOT pt 12 ps 0.9
+set style line 38 lc rgb "#005A42" lw 1.5 dt @DOT pt 4  ps 0.8
+set style line 41 lc rgb "#E69F00" lw 1.5 dt 1 pt 7  ps 0.8
+set style line 42 lc rgb "#E69F00" lw 1.5 dt @DASH pt 9  ps 0.9
+set style line 43 lc rgb "#E69F00" lw 1.5 dt @DASHDOT pt 13 ps 0.9
+set style line 51 lc rgb "#CC79A7" lw 1.5 dt 1 pt 11 ps 0.9
+set style line 61 lc rgb "#56B4E9" lw 1.5 dt 1 pt 15 ps 0.9
+set style line 62 lc rgb "#56B4E9" lw 1.5 dt @DASH pt 14 ps 0.9
+# The convergence study's isolation runs (all DLA): a = 0 dark, a = 0.25 blue.
+set style line 71 lc rgb "#003D66" lw 1.5 dt 1 pt 7  ps 0.8
+set style line 72 lc rgb "#003D66" lw 1.5 dt @DASH pt 9  ps 0.9
+set style line 73 lc rgb "#003D66" lw 1.5 dt @DASHDOT pt 13 ps 0.9
+set style line 74 lc rgb "#003D66" lw 1.5 dt @DOT pt 5  ps 0.8
+set style line 75 lc rgb "#0072B2" lw 1.5 dt 1 pt 6  ps 0.8
+set style line 76 lc rgb "#0072B2" lw 1.5 dt @DASH pt 8  ps 0.9
+set style line 77 lc rgb "#0072B2" lw 1.5 dt @DASHDOT pt 12 ps 0.9
+set style line 78 lc rgb "#0072B2" lw 1.5 dt @DOT pt 4  ps 0.8
+set style line 99 lc rgb "#999999" lw 1.0 dt 1 pt 6  ps 0.8
 method_ls(label) = \
+  label eq "reference" ? 10 : \
   label eq "dla a=0.5" ? 11 : \
-  label eq "dla-sym a=0" ? 12 : \
-  label eq "dla a=0.5+triple_jump" ? 13 : \
-  label eq "rk4" ? 14 : \
-  label eq "reference" ? 15 : \
-  label eq "mp06" ? 16 : \
-  label eq "mp06+triple_jump" ? 17 : \
-  label eq "mp06+suzuki5" ? 18 : \
-  label eq "mp06+order6" ? 19 : \
-  label eq "discrete_gradient" ? 20 : \
-  label eq "discrete_gradient+triple_jump" ? 21 : \
-  label eq "dla a=0" ? 22 : \
-  label eq "dla a=0.25" ? 23 : \
-  label eq "dla a=0.75" ? 24 : \
-  label eq "dla a=1" ? 25 : \
-  label eq "dla-sym a=0.25" ? 26 : \
-  label eq "dla-sym a=0+triple_jump" ? 27 : \
-  label eq "discrete_gradient+suzuki5" ? 28 : \
-  label eq "discrete_gradient+order6" ? 29 : \
-  label eq "rkf78" ? 30 : \
-  label eq "dopri5" ? 31 : \
-  label eq "spark s=2" ? 32 : \
-  label eq "spark s=3" ? 33 : \
-  label eq "spark s=4" ? 34 : \
+  label eq "dla a=0.5+triple_jump" ? 12 : \
+  label eq "dla-sym a=0" ? 13 : \
+  label eq "dla-sym a=0+triple_jump" ? 14 : \
+  label eq "dla a=0" ? 15 : \
+  label eq "dla a=0.25" ? 16 : \
+  label eq "dla a=0.75" ? 17 : \
+  label eq "dla a=1" ? 18 : \
+  label eq "dla-sym a=0.25" ? 19 : \
+  label eq "mp06" ? 21 : \
+  label eq "mp06+triple_jump" ? 22 : \
+  label eq "mp06+suzuki5" ? 23 : \
+  label eq "mp06+order6" ? 24 : \
+  label eq "discrete_gradient" ? 31 : \
+  label eq "discrete_gradient+triple_jump" ? 32 : \
+  label eq "discrete_gradient+suzuki5" ? 33 : \
+  label eq "discrete_gradient+order6" ? 34 : \
   label eq "discrete_gradient endpoint" ? 35 : \
   label eq "discrete_gradient endpoint+triple_jump" ? 36 : \
   label eq "discrete_gradient endpoint+suzuki5" ? 37 : \
   label eq "discrete_gradient endpoint+order6" ? 38 : \
-  40
+  label eq "spark s=2" ? 41 : \
+  label eq "spark s=3" ? 42 : \
+  label eq "spark s=4" ? 43 : \
+  label eq "rk4" ? 51 : \
+  label eq "rkf78" ? 61 : \
+  label eq "dopri5" ? 62 : \
+  label eq "L_d^a + omega_d^1/2, p0 = dL/dv (a=0)" ? 71 : \
+  label eq "L_d^a + omega_d^1/2, consistent p0 (a=0)" ? 72 : \
+  label eq "L_d^1/2 + omega_d^a, p0 = dL/dv (a=0)" ? 73 : \
+  label eq "L_d^a + omega_d^a, consistent p0 (a=0)" ? 74 : \
+  label eq "L_d^a + omega_d^1/2, p0 = dL/dv (a=0.25)" ? 75 : \
+  label eq "L_d^a + omega_d^1/2, consistent p0 (a=0.25)" ? 76 : \
+  label eq "L_d^1/2 + omega_d^a, p0 = dL/dv (a=0.25)" ? 77 : \
+  label eq "L_d^a + omega_d^a, consistent p0 (a=0.25)" ? 78 : \
+  99
+# `eval SORT_BY_STY` after a script has set N and STY[1..N] (method_ls of each
+# method): ORD[1..N] lists the methods' indices (1-based) by style, i.e. by
+# family with the reference first.  Plot `for [k=1:N]` with ORD[k] to draw the
+# reference first and group the legend by family.
+SORT_BY_STY = "array ORD[N]; k_ = 0; do for [s_=1:99] { do for [i_=1:N] { if (STY[i_] == s_) { k_ = k_ + 1; ORD[k_] = i_ } } }"
 # One jq pass per figure: calling jq once per label and per data series would
 # start jq and parse the result hundreds of times a figure.  A script
 # `load`s jq_script(opts, prog, files): the gnuplot commands that ONE run of
@@ -90,3 +131,15 @@ method_ls(label) = \
 JQ_DEFS = 'def gp: (if type == "string" then . else tojson end) | tojson; ' . \
           'def jq_block($name; rows): "\($name) << EOD", (rows | @tsv), "EOD"; '
 jq_script(opts, prog, files) = sprintf("< jq -r %s '%s%s' %s", opts, JQ_DEFS, prog, files)
+# `eval stack(p, n, top, bot, gap)`: the margins of panel p (1 = top) of n
+# panels stacked between screen heights top and bot, gap apart (room for the
+# x label and the next title); a figure's legend goes above top, outside.
+stack_h(n, top, bot, gap) = (top - bot - (n - 1) * gap) / n
+stack(p, n, top, bot, gap) = sprintf("set lmargin at screen 0.10; set rmargin at screen 0.97; set tmargin at screen %g; set bmargin at screen %g", \
+  top - (p - 1) * (stack_h(n, top, bot, gap) + gap), top - (p - 1) * (stack_h(n, top, bot, gap) + gap) - stack_h(n, top, bot, gap))
+# `eval side(p, n, top, bot)`: the margins of panel p (1 = left) of n side by
+# side between screen heights top and bot; legends go below bot, outside.
+side(p, n, top, bot) = sprintf("set lmargin at screen %g; set rmargin at screen %g; set tmargin at screen %g; set bmargin at screen %g", \
+  0.075 + (p - 1) * 0.96 / n, 0.005 + p * 0.96 / n, top, bot)
+# plain(s): s with its underscores escaped, to print as is in enhanced text.
+plain(s) = strstrt(s, "_") ? s[1:strstrt(s, "_") - 1] . "\\_" . plain(s[strstrt(s, "_") + 1:]) : s

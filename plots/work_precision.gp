@@ -16,23 +16,32 @@ load jq_script(sprintf("--arg scene '%s'", scene), \
   '   jq_block("$ENERGY\($i)"; $runs[] | select(.label == $lab and .status == "ok") | [.cpu_energy, .max_energy_error])), ' . \
   '"jq_ok = 1"', file)
 if (!exists("jq_ok")) { exit error sprintf("%s: jq failed on %s, no figure drawn", out, file) }
+eval SORT_BY_STY  # ORD: the methods by family, reference first
 lab(i) = LAB[i]
 sty(i) = STY[i]
 set key noenhanced  # method labels contain underscores
-set terminal pngcairo size 1400,600 enhanced font "DejaVu Sans,10" linewidth 1.2
+set terminal pngcairo size 1500,820 enhanced font "DejaVu Sans,11" linewidth 1.2
 set output out
 set datafile separator "\t"
 set logscale xy
 set format x "10^{%L}"
 set format y "10^{%L}"
-set key top right font ",9"
 set style data linespoints
-set multiplot layout 1,2 title sprintf("Work-precision (%s): fixed-step methods over h = 0.4/2^j, adaptive ones over tolerances 1e-3 ... 1e-13", scene) noenhanced
+# Both panels over the top 75 %, one legend for both below them.
+set multiplot title sprintf("Work-precision (%s): fixed-step methods over h = 0.4/2^j, adaptive ones over tolerances 1e-3 ... 1e-13", scene) noenhanced
+set tmargin at screen 0.91
+set bmargin at screen 0.24
+set lmargin at screen 0.07
+set rmargin at screen 0.48
+set key at screen 0.07, 0.135 left top vertical maxrows 4 Left reverse font ",10" width 2 samplen 3.5 nobox noopaque
 set title "error in q at T = 10 against CPU time"
 set xlabel "CPU seconds per run"
-set ylabel "max_i |q_i(T) - q_{ref,i}(T)|"
-plot for [i=1:N] sprintf("$FINAL%d", i) u 1:2 ls sty(i) ps 0.9 t lab(i)
-set title "largest |E - E_0| over T = 10^4 against CPU time"
-set ylabel "max |E - E_0|"
-plot for [i=1:N] sprintf("$ENERGY%d", i) u 1:2 ls sty(i) ps 0.9 t lab(i)
+set ylabel "max_i |q_i(T) − q_{ref,i}(T)|".U
+plot for [k=1:N] sprintf("$FINAL%d", ORD[k]) u 1:2 ls sty(ORD[k]) t lab(ORD[k])
+set lmargin at screen 0.57
+set rmargin at screen 0.98
+unset key
+set title "largest |E − E_0| over T = 10^4 against CPU time"
+set ylabel "max |E − E_0|".U
+plot for [k=1:N] sprintf("$ENERGY%d", ORD[k]) u 1:2 ls sty(ORD[k])
 unset multiplot

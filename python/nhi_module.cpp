@@ -25,7 +25,8 @@
 // (the lists of `nhi list --json`), and
 //   nhi.scene_defaults() the scene keys that have defaults, with them (what
 //                       validate_scene() fills in: discretization, alpha,
-//                       stages, composition, start, tolerance, output_every).
+//                       stages, constraint, composition, start, tolerance,
+//                       output_every, energy_limit).
 //
 // One translation unit over the compiled library: it instantiates no stepper.
 #include <pybind11/numpy.h>
@@ -207,12 +208,12 @@ PYBIND11_MODULE(nhi, mod) {
       "The registered systems: name, n, m, params (name: default), q0, v0, reversible, separable.");
   mod.def(
       "methods", [] { return to_python(nhi::catalog()["methods"]); },
-      "Every method the studies run: label, method, discretization, alpha, stages, composition, order, symmetric,\n"
-      "implicit, adaptive, composable, group.");
+      "Every method the studies run: label, keys (the scene keys that select it), method, discretization, alpha,\n"
+      "stages, constraint, composition, order, symmetric, implicit, adaptive, composable, group.");
   mod.def(
       "compositions", [] { return to_python(nhi::catalog()["compositions"]); },
       "The compositions of a symmetric method: name, order, stages.");
   mod.def("scene_defaults", &scene_defaults,
-          "The optional scene keys and their defaults (discretization, alpha, stages, composition, start, tolerance,\n"
-          "output_every).");
+          "The optional scene keys and their defaults (discretization, alpha, stages, constraint, composition, start,\n"
+          "tolerance, output_every, energy_limit).");
 }

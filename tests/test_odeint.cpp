@@ -126,7 +126,7 @@ TEST(Odeint, IntegrateNStepsWithAComposedMethodIsNhiRunBitForBit) {
 
 TEST(Odeint, AFailingStepThrowsNamingTheStepNhiRunNames) {
   // RK4 far outside its stability interval overflows (as in test_cli).
-  const json r = nhi_run("--set method=rk4 --set h=5 --set steps=2000");
+  const json r = nhi_run("--set method=rk4 --set h=5 --set steps=2000 --set energy_limit=off");
   ASSERT_EQ(r["status"], "failed");
   const long failed = r["failure"]["step"];
   nhi::OdeintStepper<nhi::Rk4Stepper<Particle>> stepper{nhi::Rk4Stepper<Particle>(kParticle)};

@@ -9,18 +9,24 @@
 // computed; every point before it has been observed — except that a lag-1
 // stepper (the DLA) reports point k only once q_{k+1} is known, so a failure
 // computing q_j leaves points 0 .. j-2 observed.
+//
+// An optional *guard* (guard.hpp: EnergyGuard) checks every point before the
+// observer sees it and may end the run failed there (a blown-up run: its
+// energy past a limit, or a non-finite state); without one (NoGuard) the loop
+// checks nothing beyond what the stepper reports.
 #pragma once
 
 #include <type_traits>
 #include <utility>
 
+#include "nhi/guard.hpp"
 #include "nhi/stepper.hpp"
 
 namespace nhi {
 
-template <class Stepper, class Observer>
+template <class Stepper, class Observer, class Guard = NoGuard>
 RunReport integrate(Stepper& stepper, const Vec<double, Stepper::n>& q0, const Vec<double, Stepper::n>& v0, double h,
-                    long steps, Observer&& observe) {
+                    long steps, Observer&& observe, const Guard& guard = Guard{}) {
   constexpr int n = Stepper::n, m = Stepper::m;
   RunReport rep;
   stepper.start(q0, v0);
@@ -47,6 +53,9 @@ RunReport integrate(Stepper& stepper, const Vec<double, Stepper::n>& q0, const V
     s.k = k;
     s.t = k * h;
     stepper.sample(&s);
+    if constexpr (Guard::active) {
+      if (!guard.check(static_cast<const Sample<n, m>&>(s), &rep)) return rep;
+    }
     if (!observe(static_cast<const Sample<n, m>&>(s))) {
       rep.fail(k, FailureKind::kObserver, "stopped by observer");
       return rep;

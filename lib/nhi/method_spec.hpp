@@ -33,6 +33,10 @@ struct MethodSpec {
   // "mp06+triple_jump".  A kind no method has is labelled by its name ("rkf78").
   // Defined in lib/src/methods.cpp, where the method list is.
   std::string label() const;
+  // The scene keys that select this method, as `nhi run --set` takes them,
+  // defaults left out: "method=mp06 composition=triple_jump",
+  // "method=dla discretization=symmetric alpha=0" (lib/src/methods.cpp).
+  std::string scene_keys() const;
 };
 
 // A method's entry in the studies: "main" methods are in every study;

@@ -29,6 +29,7 @@
 
 #include "nhi/discrete_gradient.hpp"
 #include "nhi/dla_composition.hpp"
+#include "nhi/embedded_rk.hpp"
 #include "nhi/integrate.hpp"
 #include "nhi/method_spec.hpp"
 #include "nhi/mp06.hpp"
@@ -131,8 +132,32 @@ struct ReferenceMethod {
   static std::vector<StudyEntry> study_entries() { return {{spec_of(name)}}; }
 };
 
+// The adaptive explicit pairs rkf78 and dopri5 (embedded_rk.hpp): the
+// scene's tolerance is atol = rtol, h the output interval.  Only the
+// work-precision study runs them (study_methods() lists them there).
+template <class Pair>
+struct EmbeddedRkMethod {
+  static constexpr const char* name = Pair::name;
+  static constexpr bool uses_discretization = false;
+  static constexpr bool reports_p = false;
+  static constexpr double step_cost = 10.0;  // per output interval h
+  static std::string label(const MethodSpec&) { return name; }
+  static bool symmetric(const MethodSpec&) { return false; }
+  template <class S, class F>
+  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
+    EmbeddedRkOptions opt;
+    opt.atol = opt.rtol = spec.tolerance;
+    EmbeddedRkStepper<S, Pair> st(sys, opt);
+    return f(st);
+  }
+  static std::vector<StudyEntry> study_entries() { return {}; }
+};
+using Rkf78Method = EmbeddedRkMethod<Rkf78Pair>;
+using Dopri5Method = EmbeddedRkMethod<Dopri5Pair>;
+
 // Every method the library has.
-using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod, Mp06Method, DiscreteGradientMethod, SparkMethod>;
+using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod, Mp06Method, DiscreteGradientMethod, SparkMethod,
+                         Rkf78Method, Dopri5Method>;
 
 inline std::vector<std::string> method_names() {
   std::vector<std::string> names;
@@ -169,7 +194,7 @@ inline MethodFlags method_flags(const std::string& kind) {
 // The estimated cost of a step of the method spec names, in RK4 steps of the
 // same scene: its step_cost times the composition's stages.  Only the balance
 // of the studies' threads and ranks depends on it.
-// A kind no method has (the studies' external methods) counts as one RK4 step.
+// A kind no method has counts as one RK4 step.
 inline double method_step_cost(const MethodSpec& spec) {
   double w = 1.0;
   for_each_type(Methods{}, [&](auto tag) {
@@ -205,17 +230,16 @@ auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
 // study; "variant"s (the paper's other alphas, the costlier compositions) in
 // those that sweep them; "costly" ones (a step of 25 to 1000 RK4 steps: SPARK's
 // dense solve) in the studies of short runs only (convergence, stability,
-// geometry, bench_steps), not in the long-horizon, timed and many-state ones.  Entries with external = true are not library methods
-// (Boost.Odeint's adaptive pairs, run by the work-precision study only; their
-// spec names a kind no method has, so it cannot be run by mistake); they are
-// listed here so that their labels are fixed in the same place.
+// geometry, bench_steps), not in the long-horizon, timed and many-state ones.
+// Entries with external = true (the adaptive pairs rkf78 and dopri5) are run
+// by the work-precision study only, over tolerances.
 struct StudyMethod {
   MethodSpec spec;
   std::string group;  // "main", "variant" or "costly"
-  bool external = false;
+  bool external = false;  // the work-precision study's adaptive pairs
   std::string external_label;
   std::string label() const { return external ? external_label : spec.label(); }
-  // A library method with a fixed step (not the adaptive reference, not external).
+  // A method with a fixed step (not the adaptive reference, not the pairs).
   bool fixed_step() const { return !external && spec.kind != ReferenceMethod::name; }
 };
 
@@ -227,8 +251,8 @@ inline const std::vector<StudyMethod>& study_methods() {
         for (const StudyEntry& e : decltype(tag)::type::study_entries())
           if (e.group == group) out.push_back({e.spec, e.group, false, ""});
       });
-    out.push_back({spec_of("rkf78"), "main", true, "rkf78"});
-    out.push_back({spec_of("dopri5"), "main", true, "dopri5"});
+    out.push_back({spec_of(Rkf78Method::name), "main", true, Rkf78Method::name});
+    out.push_back({spec_of(Dopri5Method::name), "main", true, Dopri5Method::name});
     return out;
   }();
   return list;

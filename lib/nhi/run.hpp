@@ -16,6 +16,7 @@
 #include <functional>
 #include <memory>
 
+#include "nhi/guard.hpp"
 #include "nhi/method_spec.hpp"
 #include "nhi/stepper.hpp"
 
@@ -37,10 +38,11 @@ class AnyStepper {
   virtual Vec<double, 2 * n> phase() const = 0;  // (q, p) or (q, v) of the newest point
 };
 
-// Run spec on sys from (q0, v0) with step h for `steps` steps (integrate.hpp).
+// Run spec on sys from (q0, v0) with step h for `steps` steps (integrate.hpp),
+// held to `limit` (guard.hpp: off, or the run fails where it blows up).
 template <class S>
 RunReport run_spec(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
-                   double h, long steps, const SampleObserver<S::n, S::m>& observe);
+                   double h, long steps, const SampleObserver<S::n, S::m>& observe, const EnergyLimit& limit);
 
 // The method's declared traits (order, symmetry, ...), for tests and studies.
 template <class S>
@@ -50,12 +52,13 @@ MethodTraits method_traits(const S& sys, const MethodSpec& spec);
 template <class S>
 std::unique_ptr<AnyStepper<S::n, S::m>> make_stepper(const S& sys, const MethodSpec& spec);
 
-// run_spec with any callable observer (held by reference for the call).
+// run_spec with any callable observer (held by reference for the call); no
+// energy limit unless one is given.
 template <class S, class Observer>
 RunReport run_method(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
-                     double h, long steps, Observer&& observe) {
+                     double h, long steps, Observer&& observe, const EnergyLimit& limit = EnergyLimit::off()) {
   const SampleObserver<S::n, S::m> ref = [&observe](const Sample<S::n, S::m>& s) { return bool(observe(s)); };
-  return run_spec<S>(sys, spec, q0, v0, h, steps, ref);
+  return run_spec<S>(sys, spec, q0, v0, h, steps, ref, limit);
 }
 
 }  // namespace nhi

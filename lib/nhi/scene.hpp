@@ -4,7 +4,8 @@
 //   system         a registered system's name (nhi list)      (required)
 //   params         object of system parameters                  (default: the system's)
 //   q0, v0         arrays of n numbers; v0 must satisfy omega(q0) v0 = 0   (required)
-//   method         a method's name (nhi list): "dla", "rk4", "benchmark", ...  (required)
+//   method         a method's name (nhi list): "dla", "rk4", "benchmark" (the
+//                  reference solution), "mp06", "rkf78", ...  (required)
 //   composition    "none" | "triple_jump" | "suzuki5" | "order6"  (default "none");
 //                  anything but "none" only with a symmetric method: mp06,
 //                  discrete_gradient, spark, dla with alpha 0.5 or discretization "symmetric"
@@ -18,11 +19,14 @@
 //   h              number > 0                                    (required)
 //   steps          integer >= 1                                  (required)
 //   tolerance      number in (0, 1): implicit methods' relative residual (default 1e-12),
-//                  CVODE rtol = atol for the benchmark (default 1e-12); unused by rk4
+//                  rtol = atol of the reference solution (CVODE), rkf78 and dopri5; unused by rk4
 //   output_every   integer >= 1: record steps 0, s, 2s, ... and the last (default 1)
 //   start          "predictor" | "continuation": where an implicit method's step
 //                  solve starts, its own predictor or the root continued from
 //                  h -> 0 (solver.hpp)                          (default "predictor")
+//   energy_limit   "auto" | "off" | number > 0: a run whose |E - E0| passes
+//                  max(|E0|, 1) ("auto"), or the number, ends "failed" there, as
+//                  does a non-finite state (guard.hpp); "off": no check (default "auto")
 // Every number must be finite and at most 1e100 in magnitude.
 // Unknown keys are rejected (a misspelt key must not silently fall back to a default).
 // validate_scene() returns the resolved scene with every default filled in, or

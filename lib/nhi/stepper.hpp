@@ -34,6 +34,7 @@ enum class FailureKind {
   kNonFinite,    // a state, residual or momentum became non-finite
   kInterrupted,  // SIGINT/SIGTERM (interrupt_flag())
   kObserver,     // the observer asked to stop
+  kEnergy,       // |E - E0| passed the run's energy limit (guard.hpp)
 };
 
 inline const char* to_string(FailureKind k) {
@@ -48,6 +49,8 @@ inline const char* to_string(FailureKind k) {
       return "interrupted";
     case FailureKind::kObserver:
       return "observer";
+    case FailureKind::kEnergy:
+      return "energy";
   }
   return "?";
 }
@@ -83,7 +86,8 @@ struct StepSummary {
   double relative_residual = 0;              // final max_i |r_i| / size of the terms of r_i
   bool used_fallback = false;
   long rhs_evaluations = 0;  // explicit methods and the reference solution
-  long internal_steps = 0;   // adaptive methods
+  long internal_steps = 0;   // adaptive methods: accepted steps
+  long rejected_steps = 0;   // adaptive methods: steps the error control rejected
   std::string message;       // why it failed, when it did
   RootCheck root = RootCheck::kUnchecked;
   // Merge the root check of another solve of the same step (a stage, a retry).
@@ -127,7 +131,14 @@ struct RunReport {
   long residual_evaluations = 0;
   long fallbacks = 0;        // implicit steps that needed the fallback solver
   long rhs_evaluations = 0;  // explicit methods and the reference solution
-  long internal_steps = 0;   // adaptive methods
+  long internal_steps = 0;   // adaptive methods: accepted steps
+  long rejected_steps = 0;   // adaptive methods: steps the error control rejected
+  // The guard (guard.hpp): the first point past the energy limit (-1: none;
+  // set when the limit only records), |E - E0| there or at the point that
+  // ended the run, and whether the guard ended it.
+  long energy_exceeded_step = -1;
+  double energy_error_at_limit = 0;
+  bool stopped_by_guard = false;
   // With SolverOptions::root_check: steps whose root was checked, steps that
   // took another root than the one continued from h -> 0, steps with no
   // continued root, and the first step of either kind (-1: none).
@@ -145,6 +156,7 @@ struct RunReport {
     fallbacks += s.used_fallback ? 1 : 0;
     rhs_evaluations += s.rhs_evaluations;
     internal_steps += s.internal_steps;
+    rejected_steps += s.rejected_steps;
     if (s.root != RootCheck::kUnchecked) ++root_checked_steps;
     if (s.root == RootCheck::kOther) ++other_root_steps;
     if (s.root == RootCheck::kNotFound) ++no_continued_root_steps;

@@ -67,7 +67,9 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
     throw std::runtime_error("output '" + path + "' is a directory");
   tmp_ = path + ".tmp." + std::to_string(::getpid());
-  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  do {
+    fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  } while (fd_ < 0 && errno == EINTR);
   if (fd_ < 0) throw std::runtime_error("cannot write output '" + path + "': " + std::strerror(errno));
 }
 
@@ -83,22 +85,26 @@ void AtomicFile::discard() {
 
 void AtomicFile::commit(const std::string& text) {
   if (fd_ < 0) throw std::runtime_error("output '" + path_ + "' already closed");
+  // The first failure's errno, and what failed: an errno read later may be
+  // another call's (or stale).
+  int err = 0;
+  const char* what = "";
   size_t done = 0;
-  bool ok = true;
-  while (ok && done < text.size()) {
+  while (err == 0 && done < text.size()) {
     const ssize_t k = ::write(fd_, text.data() + done, text.size() - done);
+    if (k < 0 && errno == EINTR) continue;  // a signal (SIGINT/SIGTERM set a flag) before any byte
     if (k < 0)
-      ok = false;
+      err = errno, what = "write";
     else
       done += static_cast<size_t>(k);
   }
-  ok = ok && ::fsync(fd_) == 0;
-  const int saved = errno;
-  ok = (::close(fd_) == 0) && ok;
+  if (err == 0 && ::fsync(fd_) != 0) err = errno, what = "fsync";
+  if (::close(fd_) != 0 && err == 0) err = errno, what = "close";
   fd_ = -1;
-  if (!ok || std::rename(tmp_.c_str(), path_.c_str()) != 0) {
+  if (err == 0 && std::rename(tmp_.c_str(), path_.c_str()) != 0) err = errno, what = "rename";
+  if (err != 0) {
     ::unlink(tmp_.c_str());
-    throw std::runtime_error("cannot write output '" + path_ + "': " + std::strerror(saved ? saved : errno));
+    throw std::runtime_error("cannot write output '" + path_ + "' (" + what + "): " + std::strerror(err));
   }
 }
 

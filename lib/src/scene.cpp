@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cerrno>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <limits>
@@ -23,7 +25,7 @@ using namespace scene_detail;
 const std::vector<std::string> kKeys = {"system",         "params",      "q0",    "v0",    "method",
                                         "discretization", "alpha",       "h",     "steps", "tolerance",
                                         "output_every",   "composition", "start", "stages",
-                                        "constraint"};
+                                        "constraint",     "energy_limit"};
 
 long peak_rss_kb() {
   rusage ru{};
@@ -35,6 +37,12 @@ double cpu_seconds() {
   timespec ts{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// The scene's "energy_limit" (validated): "auto" max(|E0|, 1), "off", or a bound on |E - E0|.
+EnergyLimit energy_limit_of(const json& j) {
+  if (j.is_number()) return EnergyLimit::absolute_bound(j.get<double>());
+  return j == "off" ? EnergyLimit::off() : EnergyLimit::runner_default();
 }
 
 template <class S>
@@ -58,14 +66,18 @@ json run_system(const S& sys, const json& sc) {
   spec.start = sc["start"];
   spec.stages = sc["stages"];
   spec.constraint = sc["constraint"];
-  const RunReport rep = run_method(sys, spec, q0, v0, h, steps, rec);
+  const RunReport rep = run_method(sys, spec, q0, v0, h, steps, rec, energy_limit_of(sc["energy_limit"]));
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu = cpu_seconds() - cpu0;
 
   json out;
   out["scene"] = sc;
   out["status"] = rep.ok ? "ok" : "failed";
-  if (!rep.ok) out["failure"] = {{"step", rep.failure_step}, {"time", rep.failure_step * h}, {"reason", rep.reason}};
+  if (!rep.ok)
+    out["failure"] = {{"step", rep.failure_step},
+                      {"time", rep.failure_step * h},
+                      {"kind", to_string(rep.failure)},
+                      {"reason", rep.reason}};
   rec.write(&out);
   out["stats"] = {{"wall_seconds", wall},
                   {"cpu_seconds", cpu},
@@ -75,6 +87,7 @@ json run_system(const S& sys, const json& sc) {
                   {"fallback_steps", rep.fallbacks},
                   {"rhs_evaluations", rep.rhs_evaluations},
                   {"internal_steps", rep.internal_steps},
+                  {"rejected_steps", rep.rejected_steps},
                   {"peak_rss_kb", peak_rss_kb()}};  // of the process so far, before serialization
   out["meta"] = meta();
   return out;
@@ -152,10 +165,10 @@ json catalog() {
   using First = typename At<Systems, 0>::type;
   out["methods"] = json::array();
   for (const StudyMethod& m : study_methods()) {
-    if (m.external) continue;
     const MethodTraits t = method_traits(First{}, m.spec);
     out["methods"].push_back(
         {{"label", m.label()},
+         {"keys", m.spec.scene_keys()},
          {"method", m.spec.kind},
          {"discretization",
           method_flags(m.spec.kind).uses_discretization ? json(m.spec.discretization) : json(nullptr)},
@@ -177,8 +190,9 @@ json catalog() {
 }
 
 json load_scene_file(const std::string& path) {
+  errno = 0;
   std::ifstream in(path);
-  if (!in) throw SceneError("cannot read scene file '" + path + "'");
+  if (!in) throw SceneError("cannot read scene file '" + path + "': " + std::strerror(errno ? errno : ENOENT));
   std::stringstream ss;
   ss << in.rdbuf();
   return parse_scene_text(ss.str(), "scene file '" + path + "'");
@@ -236,7 +250,7 @@ void apply_override(json* scene, const std::string& assignment) {
 json validate_scene(const json& scene) {
   if (!scene.is_object()) throw SceneError("scene must be a JSON object, got " + show(scene));
   for (const auto& [key, value] : scene.items())
-    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end()) fail(key, "unknown key");
+    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end()) unknown_key(key, kKeys);
   for (const char* key : {"system", "q0", "v0", "method", "h", "steps"})
     if (!scene.contains(key)) fail(key, "missing (required)");
 
@@ -277,6 +291,17 @@ json validate_scene(const json& scene) {
   const double tol = scene.contains("tolerance") ? finite_number(scene["tolerance"], "tolerance") : 1e-12;
   if (!(tol > 0 && tol < 1)) fail("tolerance", "must be in (0, 1), got " + show(scene["tolerance"]));
   r["tolerance"] = tol;
+  if (!scene.contains("energy_limit")) {
+    r["energy_limit"] = "auto";
+  } else if (scene["energy_limit"].is_string()) {
+    r["energy_limit"] = one_of(scene["energy_limit"], "energy_limit", {"auto", "off"});
+  } else {
+    if (!scene["energy_limit"].is_number())
+      fail("energy_limit", "must be \"auto\", \"off\" or a number > 0, got " + show(scene["energy_limit"]));
+    const double lim = finite_number(scene["energy_limit"], "energy_limit");
+    if (!(lim > 0)) fail("energy_limit", "must be > 0, got " + show(scene["energy_limit"]));
+    r["energy_limit"] = lim;
+  }
   r["output_every"] =
       scene.contains("output_every") ? integer(scene["output_every"], "output_every", 1, 10'000'000'000L) : 1L;
   if (!std::isfinite(h * double(r["steps"].get<long>()))) fail("h", "h * steps is not finite");

@@ -48,8 +48,11 @@ class Holder final : public AnyStepper<St::n, St::m> {
 
 template <class S>
 RunReport run_spec(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
-                   double h, long steps, const SampleObserver<S::n, S::m>& observe) {
-  return with_stepper(sys, spec, [&](auto& st) { return integrate(st, q0, v0, h, steps, observe); });
+                   double h, long steps, const SampleObserver<S::n, S::m>& observe, const EnergyLimit& limit) {
+  return with_stepper(sys, spec, [&](auto& st) {
+    if (!limit.on()) return integrate(st, q0, v0, h, steps, observe);
+    return integrate(st, q0, v0, h, steps, observe, EnergyGuard<S>(sys, q0, v0, limit));
+  });
 }
 
 template <class S>
@@ -72,7 +75,7 @@ NHI_STEPPER_INSTANCES(, nhi::SlotSystem)
 namespace nhi {
 template RunReport run_spec<SlotSystem>(const SlotSystem&, const MethodSpec&, const Vec<double, SlotSystem::n>&,
                                         const Vec<double, SlotSystem::n>&, double, long,
-                                        const SampleObserver<SlotSystem::n, SlotSystem::m>&);
+                                        const SampleObserver<SlotSystem::n, SlotSystem::m>&, const EnergyLimit&);
 template MethodTraits method_traits<SlotSystem>(const SlotSystem&, const MethodSpec&);
 template std::unique_ptr<AnyStepper<SlotSystem::n, SlotSystem::m>> make_stepper<SlotSystem>(const SlotSystem&,
                                                                                             const MethodSpec&);

@@ -165,14 +165,16 @@ def test_lists_are_those_of_nhi_list(tmp_path):
     assert nhi.compositions() == listed["compositions"]
     particle = next(s for s in nhi.systems() if s["name"] == "particle")
     assert particle["params"] == {"kx": 1.0, "ky": 1.0}
-    assert {m["method"] for m in nhi.methods()} >= {"dla", "rk4", "benchmark", "mp06", "discrete_gradient", "spark"}
+    assert {m["method"] for m in nhi.methods()} >= {"dla", "rk4", "benchmark", "mp06", "discrete_gradient", "spark",
+                                                    "rkf78", "dopri5"}
 
 
 def test_scene_defaults_are_what_a_run_fills_in():
     # README "Scene format": the defaults of the optional keys.
     defaults = nhi.scene_defaults()
     assert defaults == {"discretization": "alpha", "alpha": 0.5, "stages": 2, "constraint": "midpoint",
-                        "composition": "none", "start": "predictor", "tolerance": 1e-12, "output_every": 1}
+                        "composition": "none", "start": "predictor", "tolerance": 1e-12, "output_every": 1,
+                        "energy_limit": "auto"}
     scene = {k: v for k, v in load_scene("particle.json").items() if k in ("system", "q0", "v0", "method", "h")}
     resolved = nhi.run({**scene, "steps": 3})["scene"]
     assert {k: resolved[k] for k in defaults} == defaults
@@ -217,3 +219,18 @@ def test_runs_in_threads_at_once_are_the_runs_alone():
     for a, b in zip(alone, together):
         for key in ("t", "q", "v", "energy", "constraint"):
             assert np.array_equal(a[key], b[key]), key
+
+
+def test_a_blown_up_run_fails_and_the_pairs_run():
+    # README "Running a scene": |E - E0| past max(|E0|, 1) ends the run failed;
+    # rkf78 and dopri5 run at their tolerance, the output grid exact.
+    scene = load_scene("particle.json")
+    blown = nhi.run({**scene, "method": "mp06", "h": 3, "steps": 100})
+    assert blown["status"] == "failed" and blown["failure"]["kind"] == "energy"
+    assert len(blown["t"]) == blown["failure"]["step"]
+    for method in ("rkf78", "dopri5"):
+        r = nhi.run({**scene, "method": method, "tolerance": 1e-9, "h": 0.5, "steps": 8})
+        assert r["status"] == "ok"
+        assert list(r["t"]) == [0.5 * k for k in range(9)]
+        assert r["stats"]["internal_steps"] > 8
+
