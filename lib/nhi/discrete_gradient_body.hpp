@@ -1,7 +1,7 @@
 // The bodies of DiscreteGradientStepper's members (discrete_gradient.hpp):
 // the construction, start, map, the fixed-point passes, step, sample and
 // phase, which run the step's passes, solve and autodiff.  Included by the
-// library's explicit instantiations (lib/src/system_slot.cpp), which compile
+// library's explicit instantiations (lib/src/methods/discrete_gradient.cpp), which compile
 // them once for every registered system, and by code that instantiates
 // DiscreteGradientStepper for a system outside the registry (a test's own
 // system); code that includes only discrete_gradient.hpp links to the
@@ -465,4 +465,11 @@ auto DiscreteGradientStepper<S>::phase() const -> Vec<double, 2 * n> {
 
 }  // namespace nhi
 
-#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again
+// The library compiles DiscreteGradientStepper for every registered system (lib/src/methods/discrete_gradient.cpp):
+// where this body is included, those instances are declared, not compiled again.
+#include "nhi/systems/registry.hpp"
+// clang-format off
+#define NHI_EXTERN_INSTANCES_(S) extern template class nhi::DiscreteGradientStepper<nhi::S>;
+// clang-format on
+NHI_REGISTERED_SYSTEMS(NHI_EXTERN_INSTANCES_)
+#undef NHI_EXTERN_INSTANCES_

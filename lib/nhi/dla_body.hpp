@@ -1,6 +1,6 @@
 // The bodies of DlaStepper's entry points (dla.hpp): the construction, start,
 // step, next_guess and sample that run the step's solve and predictor.  The
-// library compiles them once for every registered system (lib/src/system_slot.cpp);
+// library compiles them once for every registered system (lib/src/methods/dla_*.cpp);
 // include this header only to instantiate DlaStepper for a system outside the
 // registry (a test's own system).
 #pragma once
@@ -130,4 +130,11 @@ void DlaStepper<S, D>::next_guess(double h, VecN* q_guess, VecM* lambda_guess, i
 
 }  // namespace nhi
 
-#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again
+// The library compiles DlaStepper for every registered system (lib/src/methods/dla_*.cpp):
+// where this body is included, those instances are declared, not compiled again.
+#include "nhi/systems/registry.hpp"
+// clang-format off
+#define NHI_EXTERN_INSTANCES_(S) extern template class nhi::DlaStepper<nhi::S, nhi::AlphaDiscretization>; extern template class nhi::DlaStepper<nhi::S, nhi::SymmetricDiscretization>; extern template class nhi::DlaStepper<nhi::S, nhi::SplitDiscretization>;
+// clang-format on
+NHI_REGISTERED_SYSTEMS(NHI_EXTERN_INSTANCES_)
+#undef NHI_EXTERN_INSTANCES_

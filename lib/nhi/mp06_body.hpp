@@ -1,7 +1,7 @@
 // The bodies of Mp06Stepper's members (mp06.hpp): the construction (with
 // the structural probe explicit_structure), start, map, step, sample and
 // phase, which run the step's solve and its autodiff.  Included by the
-// library's explicit instantiations (lib/src/system_slot.cpp), which compile
+// library's explicit instantiations (lib/src/methods/mp06.cpp), which compile
 // them once for every registered system, and by code that instantiates
 // Mp06Stepper for a system outside the registry (a test's own system); code
 // that includes only mp06.hpp links to the library's instances.
@@ -120,4 +120,11 @@ auto Mp06Stepper<S, kSeparableForm>::phase() const -> Vec<double, 2 * n> {
 
 }  // namespace nhi
 
-#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again
+// The library compiles Mp06Stepper for every registered system (lib/src/methods/mp06.cpp):
+// where this body is included, those instances are declared, not compiled again.
+#include "nhi/systems/registry.hpp"
+// clang-format off
+#define NHI_EXTERN_INSTANCES_(S) extern template class nhi::Mp06Stepper<nhi::S, true>; extern template class nhi::Mp06Stepper<nhi::S, false>;
+// clang-format on
+NHI_REGISTERED_SYSTEMS(NHI_EXTERN_INSTANCES_)
+#undef NHI_EXTERN_INSTANCES_

@@ -1,6 +1,6 @@
 // The bodies of ReferenceStepper's start and step (reference.hpp), which run
 // CVODE.  The library compiles them once for every registered system
-// (lib/src/system_slot.cpp); include this header only to run the reference
+// (lib/src/methods/reference.cpp); include this header only to run the reference
 // solution on a system outside the registry (a test's own system).
 #pragma once
 
@@ -41,4 +41,11 @@ StepSummary ReferenceStepper<S>::step(double h) {
 
 }  // namespace nhi
 
-#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again
+// The library compiles ReferenceStepper for every registered system (lib/src/methods/reference.cpp):
+// where this body is included, those instances are declared, not compiled again.
+#include "nhi/systems/registry.hpp"
+// clang-format off
+#define NHI_EXTERN_INSTANCES_(S) extern template class nhi::ReferenceStepper<nhi::S>;
+// clang-format on
+NHI_REGISTERED_SYSTEMS(NHI_EXTERN_INSTANCES_)
+#undef NHI_EXTERN_INSTANCES_

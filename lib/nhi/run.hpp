@@ -1,10 +1,12 @@
 // Running a method by its MethodSpec on a registered system, compiled once.
 //
-// run_method(), method_traits() and make_stepper() below are declared here and
-// instantiated for every registered system (systems/registry.hpp) in the
-// library, one translation unit per system (lib/src/system_slot.cpp), so that a
-// study, a test or the runner that runs methods by name does not compile every
-// method's stepper and Newton solver again.  The observer is called through a
+// run_spec(), method_traits() and make_stepper() below are declared here and
+// compiled in the library for every registered system (systems/registry.hpp):
+// they find the method by its name (lib/src/run.cpp) and call its MethodRun,
+// which each method's own translation unit instantiates beside its steppers
+// (lib/src/methods/*.cpp), so that a study, a test or the runner that runs
+// methods by name does not compile every method's stepper and Newton solver
+// again, and a change to one method's body recompiles that method only.  The observer is called through a
 // std::function (one indirect call per time point; the arithmetic of a run is
 // the same as with integrate() on the concrete stepper, bit for bit).
 //
@@ -51,6 +53,18 @@ MethodTraits method_traits(const S& sys, const MethodSpec& spec);
 // The stepper spec names, type-erased; an unknown name throws.
 template <class S>
 std::unique_ptr<AnyStepper<S::n, S::m>> make_stepper(const S& sys, const MethodSpec& spec);
+
+// One method M (a type of methods.hpp's Methods) on one system S: what the
+// three functions above do once the method is found.  Defined in
+// run_body.hpp; instantiated in M's translation unit for every registered system.
+template <class M, class S>
+struct MethodRun {
+  static RunReport run(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0,
+                       const Vec<double, S::n>& v0, double h, long steps, const SampleObserver<S::n, S::m>& observe,
+                       const EnergyLimit& limit);
+  static MethodTraits traits(const S& sys, const MethodSpec& spec);
+  static std::unique_ptr<AnyStepper<S::n, S::m>> make(const S& sys, const MethodSpec& spec);
+};
 
 // run_spec with any callable observer (held by reference for the call); no
 // energy limit unless one is given.

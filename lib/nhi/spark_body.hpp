@@ -1,6 +1,6 @@
 // The bodies of SparkStepper's members (spark.hpp): start, map, step, sample
 // and phase, which run the step's solve and its autodiff.  Included by the
-// library's explicit instantiations (lib/src/system_slot.cpp), which compile
+// library's explicit instantiations (lib/src/methods/spark.cpp), which compile
 // them once for every registered system, and by code that instantiates
 // SparkStepper for a system outside the registry; code that includes only
 // spark.hpp links to the library's instances.
@@ -73,4 +73,11 @@ auto SparkStepper<S, s>::phase() const -> Vec<double, 2 * n> {
 
 }  // namespace nhi
 
-#include "nhi/instances.hpp"  // after the bodies: the library's instances are not compiled again
+// The library compiles SparkStepper for every registered system (lib/src/methods/spark.cpp):
+// where this body is included, those instances are declared, not compiled again.
+#include "nhi/systems/registry.hpp"
+// clang-format off
+#define NHI_EXTERN_INSTANCES_(S) extern template class nhi::SparkStepper<nhi::S, 2>; extern template class nhi::SparkStepper<nhi::S, 3>; extern template class nhi::SparkStepper<nhi::S, 4>;
+// clang-format on
+NHI_REGISTERED_SYSTEMS(NHI_EXTERN_INSTANCES_)
+#undef NHI_EXTERN_INSTANCES_

@@ -1,0 +1,11 @@
+// The discrete gradient (discrete_gradient.hpp), its stepper and runner glue, compiled
+// for every registered system: this method's translation unit (run.hpp).
+#include "nhi/methods.hpp"
+#include "nhi/discrete_gradient_body.hpp"
+#include "nhi/run_body.hpp"
+#include "nhi/systems/registry.hpp"
+
+// clang-format off
+#define NHI_INSTANCES_(S) template class nhi::DiscreteGradientStepper<nhi::S>; template struct nhi::MethodRun<nhi::DiscreteGradientMethod, nhi::S>;
+// clang-format on
+NHI_REGISTERED_SYSTEMS(NHI_INSTANCES_)

@@ -1,0 +1,10 @@
+// The DLA (dla.hpp, dla_composition.hpp): its runner glue (MethodRun), compiled
+// for every registered system: this method's translation unit (run.hpp).
+#include "nhi/methods.hpp"
+#include "nhi/run_body.hpp"
+#include "nhi/systems/registry.hpp"
+
+// clang-format off
+#define NHI_INSTANCES_(S) template struct nhi::MethodRun<nhi::DlaMethod, nhi::S>;
+// clang-format on
+NHI_REGISTERED_SYSTEMS(NHI_INSTANCES_)

@@ -1,0 +1,10 @@
+// DlaStepper with L_d^alpha, omega_d^alpha (eqs. 9, 13), compiled
+// for every registered system: this method's translation unit (run.hpp).
+#include "nhi/dla_body.hpp"
+#include "nhi/run_body.hpp"
+#include "nhi/systems/registry.hpp"
+
+// clang-format off
+#define NHI_INSTANCES_(S) template class nhi::DlaStepper<nhi::S, nhi::AlphaDiscretization>;
+// clang-format on
+NHI_REGISTERED_SYSTEMS(NHI_INSTANCES_)
