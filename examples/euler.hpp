@@ -33,7 +33,8 @@ class EulerStepper {
 };
 struct EulerMethod {
   static constexpr const char* name = "euler";
-  static constexpr bool uses_discretization = false, reports_p = false;
+  static constexpr bool adaptive = false, reports_p = false;
+  static std::vector<MethodKey> keys() { return {}; }  // its own scene keys, none
   static constexpr double step_cost = 1.0;  // in RK4 steps, for scheduling the studies
   static std::string label(const MethodSpec&) { return name; }  // its plot style's key
   static bool symmetric(const MethodSpec&) { return false; }

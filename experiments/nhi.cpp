@@ -86,13 +86,14 @@ std::string params_of(const nhi::json& sys) {
   return out.empty() ? "-" : out;
 }
 
+// The method's scene keys with their values: "method", its own keys in their
+// declared order (the catalog's "own"), then a composition if any.
 std::string method_keys(const nhi::json& m) {
   std::string out = "\"method\": \"" + m["method"].get<std::string>() + "\"";
-  if (!m["discretization"].is_null())
-    out += ", \"discretization\": \"" + m["discretization"].get<std::string>() + "\", \"alpha\": " + num(m["alpha"]);
-  if (m.contains("stages") && !m["stages"].is_null()) out += ", \"stages\": " + num(m["stages"]);
-  if (m.contains("constraint") && m["constraint"] == "endpoint")
-    out += ", \"constraint\": \"" + m["constraint"].get<std::string>() + "\"";
+  for (const auto& key : m["own"]) {
+    const nhi::json& v = m[key.get<std::string>()];
+    out += ", \"" + key.get<std::string>() + "\": " + (v.is_string() ? v.dump() : num(v));
+  }
   if (m["composition"] != "none") out += ", \"composition\": \"" + m["composition"].get<std::string>() + "\"";
   return out;
 }

@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
         }
       }
       if (!exact) {
-        nhi::MethodSpec rs = nhi::spec_of("benchmark");
+        nhi::MethodSpec rs = nhi::spec_of(nhi::ReferenceMethod::name);
         rs.tolerance = 1e-13;
         nhi::RunReport rep;
         ref = q_at(sys, rs, q0, v0, h, ks, &rep);

@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
   cells.label = "long horizon";
   cells.count = scenes.size() * methods.size();
   // Steps of method m: reference_steps for the reference solution, else kSteps.
-  auto steps_of = [&](const nhi::StudyMethod& m) { return m.spec.kind == "benchmark" ? reference_steps : kSteps; };
+  auto steps_of = [&](const nhi::StudyMethod& m) { return m.adaptive() ? reference_steps : kSteps; };
   // The longest runs first (map_cells orders them by this estimate).
   cells.cost = [&](size_t i) {
     const nhi::StudyMethod& m = methods[i % methods.size()];

@@ -179,7 +179,7 @@ int main(int argc, char** argv) {
         // Centres: the mean of the reference's section points, per state.
         size_t ref = 0;
         for (size_t m = 0; m < methods.size(); ++m)
-          if (methods[m].spec.kind == "benchmark") ref = m;
+          if (methods[m].adaptive()) ref = m;
         std::vector<double> cz(states.size()), czd(states.size()), ref_thick(states.size());
         for (size_t j = 0; j < states.size(); ++j) {
           const Section& r = secs[ref * states.size() + j];

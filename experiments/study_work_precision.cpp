@@ -103,7 +103,7 @@ struct Config {
 template <class S>
 bool long_run(const S& sys, const Config& c) {
   if (c.method.external) return c.method.external_label != "dopri5" || c.param >= kTightestTolLongDopri5 * (1 - 1e-9);
-  if (c.method.spec.kind == "benchmark") return false;  // CVODE: many times rkf78's cost per step here
+  if (c.method.adaptive()) return false;  // the reference (CVODE): many times rkf78's cost per step here
   if (c.method.group == "costly") return false;
   const nhi::MethodTraits t = nhi::method_traits(sys, c.method.spec);
   return t.preserves_energy ? c.param >= 0.4 * (1 - 1e-12) : c.param >= 0.1 * (1 - 1e-12);
@@ -125,7 +125,7 @@ bool run_library(const S& sys, const Config& c, const Vec<double, S::n>& q0, con
                  Sampler&& sample, bool guard) {
   const nhi::StudyMethod& m = c.method;
   const nhi::EnergyLimit limit = guard ? kLimit : nhi::EnergyLimit::off();
-  if (m.spec.kind == "benchmark" || m.external) {
+  if (m.adaptive()) {
     nhi::MethodSpec spec = m.spec;
     spec.tolerance = c.param;
     const double out = m.external ? T : 0.1;
@@ -223,7 +223,7 @@ int main(int argc, char** argv) {
   const auto fixed =
       study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
   const auto reference =
-      study::methods([](const nhi::StudyMethod& m) { return m.spec.kind == "benchmark" && !m.external; });
+      study::methods([](const nhi::StudyMethod& m) { return m.adaptive() && !m.external; });
   const auto external = study::methods([](const nhi::StudyMethod& m) { return m.external; });
   const auto costly = study::methods([](const nhi::StudyMethod& m) {
     return study::fixed_step(m) && m.group == "costly" && m.spec.stages >= kCostlyMinStages;
@@ -295,12 +295,11 @@ int main(int argc, char** argv) {
       cells.cost = [&](size_t i) {
         const Config& c = configs[i];
         const double T = kT_final + kT_energy + (long_scene && long_run(sys, c) ? kT_long : 0.0);
-        const bool adaptive = c.method.external || c.method.spec.kind == "benchmark";
-        return adaptive ? T * std::pow(c.param, -0.2) : T / c.param * study::step_weight(c.method.spec);
+        return c.method.adaptive() ? T * std::pow(c.param, -0.2) : T / c.param * study::step_weight(c.method.spec);
       };
       cells.run = [&](size_t i) {
         const Config& c = configs[i];
-        const bool adaptive = c.method.external || c.method.spec.kind == "benchmark";
+        const bool adaptive = c.method.adaptive();
         char param[32];
         std::snprintf(param, sizeof param, "%g", c.param);
         json row = {{"label", c.method.label()},
@@ -345,7 +344,7 @@ int main(int argc, char** argv) {
         // The reference solution's diagnosed run is its first timing when it
         // took >= kSelfTimed: its observer sees one point per 0.1 time units
         // (~1e5 energies, a few ms: under 1 % of such a run).
-        const bool self_timed = c.method.spec.kind == "benchmark" && cpu_diagnosed >= kSelfTimed;
+        const bool self_timed = c.method.adaptive() && !c.method.external && cpu_diagnosed >= kSelfTimed;
         const Timing cpu_energy = row["adaptive"].get<bool>()
                                       ? cpu_per_run(sys, c, q0, v0, kT_energy, self_timed ? cpu_diagnosed : -1)
                                       : cpu_short.scaled(kT_energy / kT_energy_short);

@@ -350,7 +350,11 @@ class DiscreteGradientStepper {
 // The method table's entry (methods.hpp): "discrete_gradient", symmetric, so composable.
 struct DiscreteGradientMethod {
   static constexpr const char* name = "discrete_gradient";
-  static constexpr bool uses_discretization = false;
+  static constexpr bool adaptive = false;
+  // Where the velocity constraint holds: at the midpoint (odelab's) or at every grid point.
+  static std::vector<MethodKey> keys() {
+    return {MethodKey::choice("constraint", &MethodSpec::constraint, {"midpoint", "endpoint"})};
+  }
   static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
   static constexpr bool reports_p = true;
   static constexpr double step_cost = 15.0;

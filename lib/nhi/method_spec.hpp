@@ -9,11 +9,15 @@
 
 namespace nhi {
 
+// The default tolerance of every method that has one (the implicit methods'
+// relative residual, the adaptive methods' rtol = atol): the scene's default.
+inline constexpr double kDefaultTolerance = 1e-12;
+
 struct MethodSpec {
   std::string kind = "dla";              // a Methods name: "dla", "rk4", "benchmark", "mp06", ...
   std::string discretization = "alpha";  // DLA: "alpha" or "symmetric"
   double alpha = 0.5;
-  double tolerance = 1e-12;          // implicit methods: relative residual; the reference: CVODE rtol = atol
+  double tolerance = kDefaultTolerance;  // implicit methods: relative residual; the reference: CVODE rtol = atol
   std::string composition = "none";  // symmetric methods: composition.hpp
   int stages = 2;                    // spark: Lobatto IIIA-IIIB stages, 2, 3 or 4 (spark.hpp)
   // discrete_gradient: where the velocity constraint holds, "midpoint" (the
@@ -37,6 +41,44 @@ struct MethodSpec {
   // defaults left out: "method=mp06 composition=triple_jump",
   // "method=dla discretization=symmetric alpha=0" (lib/src/methods.cpp).
   std::string scene_keys() const;
+};
+
+// A scene key of one method's own (its struct's keys(), methods.hpp): the
+// MethodSpec member it sets and the check a scene's value must pass.  Its
+// default is the member's default in MethodSpec.  The scene validator, the
+// catalog (`nhi list`, the Python module) and MethodSpec::scene_keys() read
+// the keys from the methods; no method's key is written anywhere else.
+struct MethodKey {
+  const char* name = "";
+  std::string MethodSpec::*text = nullptr;  // a choice among `choices`
+  std::vector<std::string> choices;
+  double MethodSpec::*number = nullptr;  // a finite number in [lo, hi]
+  int MethodSpec::*whole = nullptr;      // an integer in [lo, hi]
+  double lo = 0, hi = 0;
+
+  static MethodKey choice(const char* name, std::string MethodSpec::*m, std::vector<std::string> choices) {
+    MethodKey k;
+    k.name = name;
+    k.text = m;
+    k.choices = std::move(choices);
+    return k;
+  }
+  static MethodKey range(const char* name, double MethodSpec::*m, double lo, double hi) {
+    MethodKey k;
+    k.name = name;
+    k.number = m;
+    k.lo = lo;
+    k.hi = hi;
+    return k;
+  }
+  static MethodKey integer(const char* name, int MethodSpec::*m, int lo, int hi) {
+    MethodKey k;
+    k.name = name;
+    k.whole = m;
+    k.lo = lo;
+    k.hi = hi;
+    return k;
+  }
 };
 
 // A method's entry in the studies: "main" methods are in every study;

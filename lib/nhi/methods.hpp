@@ -3,7 +3,8 @@
 //
 // A *method* is a plain type in the TypeList `Methods` below with
 //   static constexpr const char* name;          // the scene's "method" value
-//   static constexpr bool uses_discretization;  // reads MethodSpec::discretization, alpha
+//   static constexpr bool adaptive;             // h is the output interval, not its step
+//   static std::vector<MethodKey> keys();       // its own scene keys (method_spec.hpp)
 //   static bool symmetric(const MethodSpec&);   // self-adjoint: then it accepts a
 //                                               // MethodSpec::composition (composition.hpp)
 //   static constexpr bool reports_p;            // its samples carry p and lambda
@@ -43,7 +44,13 @@ namespace nhi {
 
 struct DlaMethod {
   static constexpr const char* name = "dla";
-  static constexpr bool uses_discretization = true;
+  static constexpr bool adaptive = false;
+  // The paper's discretizations: L_d^alpha, omega_d^alpha (eqs. 9, 13) or the
+  // symmetric L_d^{sym,alpha}, omega_d^{sym,alpha} (eqs. 10, 14); alpha in [0, 1].
+  static std::vector<MethodKey> keys() {
+    return {MethodKey::choice("discretization", &MethodSpec::discretization, {"alpha", "symmetric"}),
+            MethodKey::range("alpha", &MethodSpec::alpha, 0.0, 1.0)};
+  }
   static constexpr bool reports_p = true;
   static constexpr double step_cost = 6.0;
   static std::string label(const MethodSpec& spec) {
@@ -101,7 +108,8 @@ struct DlaMethod {
 
 struct Rk4Method {
   static constexpr const char* name = "rk4";
-  static constexpr bool uses_discretization = false;
+  static constexpr bool adaptive = false;
+  static std::vector<MethodKey> keys() { return {}; }
   static constexpr bool reports_p = false;
   static constexpr double step_cost = 1.0;
   static std::string label(const MethodSpec&) { return name; }
@@ -117,7 +125,8 @@ struct Rk4Method {
 // The reference solution (scene value "benchmark", kept for the runner's contract).
 struct ReferenceMethod {
   static constexpr const char* name = "benchmark";
-  static constexpr bool uses_discretization = false;
+  static constexpr bool adaptive = true;
+  static std::vector<MethodKey> keys() { return {}; }
   static constexpr bool reports_p = false;
   static constexpr double step_cost = 30.0;  // per output interval h
   static std::string label(const MethodSpec&) { return "reference"; }
@@ -138,7 +147,8 @@ struct ReferenceMethod {
 template <class Pair>
 struct EmbeddedRkMethod {
   static constexpr const char* name = Pair::name;
-  static constexpr bool uses_discretization = false;
+  static constexpr bool adaptive = true;
+  static std::vector<MethodKey> keys() { return {}; }
   static constexpr bool reports_p = false;
   static constexpr double step_cost = 10.0;  // per output interval h
   static std::string label(const MethodSpec&) { return name; }
@@ -178,17 +188,32 @@ void with_method_type(const std::string& kind, F&& f) {
   if (!found) throw std::invalid_argument("unknown method \"" + kind + "\"");
 }
 
-// The method's declared flags, by name.
+// The method's declared flags and keys, by name.
 struct MethodFlags {
-  bool uses_discretization = false, reports_p = false;
+  bool adaptive = false, reports_p = false;
+  std::vector<MethodKey> keys;
 };
 inline MethodFlags method_flags(const std::string& kind) {
   MethodFlags fl;
   with_method_type(kind, [&](auto tag) {
     using M = typename decltype(tag)::type;
-    fl = {M::uses_discretization, M::reports_p};
+    fl = {M::adaptive, M::reports_p, M::keys()};
   });
   return fl;
+}
+
+// Every method's own keys, each once (the first method to declare a name
+// gives its check), in the order of Methods.
+inline std::vector<MethodKey> all_method_keys() {
+  std::vector<MethodKey> out;
+  for_each_type(Methods{}, [&](auto tag) {
+    for (MethodKey k : decltype(tag)::type::keys()) {
+      bool seen = false;
+      for (const MethodKey& o : out) seen = seen || std::string(o.name) == k.name;
+      if (!seen) out.push_back(std::move(k));
+    }
+  });
+  return out;
 }
 
 // The estimated cost of a step of the method spec names, in RK4 steps of the
@@ -197,10 +222,12 @@ inline MethodFlags method_flags(const std::string& kind) {
 // A kind no method has counts as one RK4 step.
 inline double method_step_cost(const MethodSpec& spec) {
   double w = 1.0;
+  bool adaptive = false;
   for_each_type(Methods{}, [&](auto tag) {
-    if (spec.kind == decltype(tag)::type::name) w = decltype(tag)::type::step_cost;
+    using M = typename decltype(tag)::type;
+    if (spec.kind == M::name) w = M::step_cost, adaptive = M::adaptive;
   });
-  return spec.kind == ReferenceMethod::name ? w : w * static_cast<double>(composition(spec.composition).gamma.size());
+  return adaptive ? w : w * static_cast<double>(composition(spec.composition).gamma.size());
 }
 
 // Is the method the spec names self-adjoint (and so composable)?
@@ -239,8 +266,10 @@ struct StudyMethod {
   bool external = false;  // the work-precision study's adaptive pairs
   std::string external_label;
   std::string label() const { return external ? external_label : spec.label(); }
+  // An adaptive method (the reference, the pairs): h is its output interval.
+  bool adaptive() const { return method_flags(spec.kind).adaptive; }
   // A method with a fixed step (not the adaptive reference, not the pairs).
-  bool fixed_step() const { return !external && spec.kind != ReferenceMethod::name; }
+  bool fixed_step() const { return !external && !adaptive(); }
 };
 
 inline const std::vector<StudyMethod>& study_methods() {

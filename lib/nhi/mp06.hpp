@@ -452,7 +452,8 @@ class Mp06Stepper {
 // The method table's entry (methods.hpp): "mp06", symmetric, so composable.
 struct Mp06Method {
   static constexpr const char* name = "mp06";
-  static constexpr bool uses_discretization = false;
+  static constexpr bool adaptive = false;
+  static std::vector<MethodKey> keys() { return {}; }
   static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
   static constexpr bool reports_p = true;
   static constexpr double step_cost = 1.5;

@@ -7,15 +7,13 @@
 //   method         a method's name (nhi list): "dla", "rk4", "benchmark" (the
 //                  reference solution), "mp06", "rkf78", ...  (required)
 //   composition    "none" | "triple_jump" | "suzuki5" | "order6"  (default "none");
-//                  anything but "none" only with a symmetric method: mp06,
-//                  discrete_gradient, spark, dla with alpha 0.5 or discretization "symmetric"
-//   discretization "alpha" | "symmetric"                         (default "alpha")
-//   alpha          number in [0, 1]                              (default 0.5)
-//                  (discretization and alpha are the DLA's; other methods ignore them)
-//   stages         integer 2, 3 or 4: spark's Lobatto IIIA-IIIB stages, of order
-//                  2 stages - 2 (default 2; other methods ignore it)
-//   constraint     "midpoint" | "endpoint": where discrete_gradient holds the
-//                  velocity constraint (default "midpoint"; others ignore it)
+//                  anything but "none" only with a symmetric method ("composable"
+//                  in nhi list)
+//   a method's own keys, declared with their checks and defaults by the method
+//   (MethodKey, methods.hpp; other methods ignore them; nhi list shows them):
+//   discretization "alpha" | "symmetric"  and  alpha, a number in [0, 1]: the
+//                  DLA's (defaults "alpha", 0.5); stages 2, 3 or 4: spark's
+//                  (default 2); constraint "midpoint" | "endpoint": discrete_gradient's
 //   h              number > 0                                    (required)
 //   steps          integer >= 1                                  (required)
 //   tolerance      number in (0, 1): implicit methods' relative residual (default 1e-12),
@@ -49,8 +47,9 @@ struct SceneError : std::runtime_error {
 
 // What the library has, for `nhi list`: {"systems": [{name, n, m, params
 // (name: default), q0, v0, reversible, separable}], "methods": [{label,
-// method, discretization, alpha, composition, order, symmetric, implicit,
-// adaptive, composable, group}] (every method the studies run), "compositions":
+// keys, method, composition, order, symmetric, implicit, adaptive, composable,
+// group, own (the method's own keys), and every method key (null where the
+// method has none)}] (every method the studies run), "compositions":
 // [{name, order, stages}]}.
 json catalog();
 

@@ -348,7 +348,9 @@ class SparkStepper {
 // The method table's entry (methods.hpp): "spark" with MethodSpec::stages = 2, 3, 4.
 struct SparkMethod {
   static constexpr const char* name = "spark";
-  static constexpr bool uses_discretization = false;
+  static constexpr bool adaptive = false;
+  // Lobatto IIIA-IIIB stages s (order 2s - 2).
+  static std::vector<MethodKey> keys() { return {MethodKey::integer("stages", &MethodSpec::stages, 2, 4)}; }
   static bool symmetric(const MethodSpec&) { return true; }  // so it composes (composition.hpp)
   static constexpr bool reports_p = true;
   static constexpr double step_cost = 250.0;  // 25 (s = 2) to 1040 (s = 4) RK4 steps

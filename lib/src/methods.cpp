@@ -1,4 +1,7 @@
-// MethodSpec::label(), which reads each method's own label from the method list.
+// MethodSpec::label() and scene_keys(), which read each method's own label
+// and keys from the method list.
+#include <cstdio>
+
 #include "nhi/methods.hpp"
 
 namespace nhi {
@@ -15,18 +18,18 @@ std::string MethodSpec::label() const {
 std::string MethodSpec::scene_keys() const {
   const MethodSpec defaults;
   std::string out = "method=" + kind;
-  bool discretized = false;
-  for_each_type(Methods{}, [&](auto tag) {
-    if (kind == decltype(tag)::type::name) discretized = decltype(tag)::type::uses_discretization;
-  });
-  if (discretized && discretization != defaults.discretization) out += " discretization=" + discretization;
-  if (discretized && alpha != defaults.alpha) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, " alpha=%g", alpha);
-    out += buf;
+  bool known = false;
+  for_each_type(Methods{}, [&](auto tag) { known = known || kind == decltype(tag)::type::name; });
+  for (const MethodKey& k : known ? method_flags(kind).keys : std::vector<MethodKey>{}) {
+    if (k.text && this->*k.text != defaults.*k.text) out += std::string(" ") + k.name + "=" + this->*k.text;
+    if (k.whole && this->*k.whole != defaults.*k.whole)
+      out += std::string(" ") + k.name + "=" + std::to_string(this->*k.whole);
+    if (k.number && this->*k.number != defaults.*k.number) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "=%g", this->*k.number);
+      out += std::string(" ") + k.name + buf;
+    }
   }
-  if (kind == SparkMethod::name && stages != defaults.stages) out += " stages=" + std::to_string(stages);
-  if (kind == DiscreteGradientMethod::name && constraint != defaults.constraint) out += " constraint=" + constraint;
   if (composition != defaults.composition) out += " composition=" + composition;
   return out;
 }

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <fstream>
@@ -22,10 +23,52 @@ namespace {
 
 using namespace scene_detail;
 
-const std::vector<std::string> kKeys = {"system",         "params",      "q0",    "v0",    "method",
-                                        "discretization", "alpha",       "h",     "steps", "tolerance",
-                                        "output_every",   "composition", "start", "stages",
-                                        "constraint",     "energy_limit"};
+// The scene's keys: the run's, then every method's own (MethodKey, methods.hpp).
+const std::vector<std::string>& scene_keys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> k = {"system", "params",       "q0",          "v0",    "method",      "h",
+                                  "steps",  "tolerance",    "output_every", "composition", "start", "energy_limit"};
+    for (const MethodKey& mk : all_method_keys()) k.push_back(mk.name);
+    return k;
+  }();
+  return keys;
+}
+
+// A method key's value in a scene (checked), or its default (MethodSpec's).
+json method_key_value(const MethodKey& k, const json& scene) {
+  const MethodSpec defaults;
+  const bool given = scene.contains(k.name);
+  if (k.text) return given ? json(one_of(scene[k.name], k.name, k.choices)) : json(defaults.*k.text);
+  if (k.whole) return given ? integer(scene[k.name], k.name, long(k.lo), long(k.hi)) : long(defaults.*k.whole);
+  if (!given) return defaults.*k.number;
+  const double x = finite_number(scene[k.name], k.name);
+  if (!(x >= k.lo && x <= k.hi)) {
+    char range[64];
+    std::snprintf(range, sizeof range, "must be in [%g, %g], got ", k.lo, k.hi);
+    fail(k.name, range + show(scene[k.name]));
+  }
+  return x;
+}
+
+// The method keys' values of a resolved scene, into spec.
+void set_method_keys(MethodSpec* spec, const json& resolved) {
+  for (const MethodKey& k : all_method_keys()) {
+    if (k.text) spec->*k.text = resolved[k.name].get<std::string>();
+    if (k.whole) spec->*k.whole = static_cast<int>(resolved[k.name].get<long>());
+    if (k.number) spec->*k.number = resolved[k.name].get<double>();
+  }
+}
+
+// The MethodSpec a resolved scene describes.
+MethodSpec spec_of_scene(const json& sc) {
+  MethodSpec spec;
+  spec.kind = sc["method"];
+  spec.tolerance = sc["tolerance"];
+  spec.composition = sc["composition"];
+  spec.start = sc["start"];
+  set_method_keys(&spec, sc);
+  return spec;
+}
 
 long peak_rss_kb() {
   rusage ru{};
@@ -50,22 +93,13 @@ json run_system(const S& sys, const json& sc) {
   constexpr int n = S::n;
   const Vec<double, n> q0 = vector_of<n>(sc["q0"], "q0");
   const Vec<double, n> v0 = vector_of<n>(sc["v0"], "v0");
-  const std::string method = sc["method"];
-  const double h = sc["h"], alpha = sc["alpha"], tol = sc["tolerance"];
+  const double h = sc["h"];
   const long steps = sc["steps"], every = sc["output_every"];
 
   Recorder<S> rec(sys, every, steps);
   const double cpu0 = cpu_seconds();
   const auto wall0 = std::chrono::steady_clock::now();
-  MethodSpec spec;
-  spec.kind = method;
-  spec.discretization = sc["discretization"];
-  spec.alpha = alpha;
-  spec.tolerance = tol;
-  spec.composition = sc["composition"];
-  spec.start = sc["start"];
-  spec.stages = sc["stages"];
-  spec.constraint = sc["constraint"];
+  const MethodSpec spec = spec_of_scene(sc);
   const RunReport rep = run_method(sys, spec, q0, v0, h, steps, rec, energy_limit_of(sc["energy_limit"]));
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu = cpu_seconds() - cpu0;
@@ -166,22 +200,27 @@ json catalog() {
   out["methods"] = json::array();
   for (const StudyMethod& m : study_methods()) {
     const MethodTraits t = method_traits(First{}, m.spec);
-    out["methods"].push_back(
-        {{"label", m.label()},
-         {"keys", m.spec.scene_keys()},
-         {"method", m.spec.kind},
-         {"discretization",
-          method_flags(m.spec.kind).uses_discretization ? json(m.spec.discretization) : json(nullptr)},
-         {"alpha", method_flags(m.spec.kind).uses_discretization ? json(m.spec.alpha) : json(nullptr)},
-         {"stages", m.spec.kind == SparkMethod::name ? json(m.spec.stages) : json(nullptr)},
-         {"constraint", m.spec.kind == DiscreteGradientMethod::name ? json(m.spec.constraint) : json(nullptr)},
-         {"composition", m.spec.composition},
-         {"order", t.order},
-         {"symmetric", t.symmetric},
-         {"implicit", t.implicit},
-         {"adaptive", t.adaptive},
-         {"composable", m.spec.composition == "none" && method_is_symmetric(m.spec)},
-         {"group", m.group}});
+    json entry = {{"label", m.label()},
+                  {"keys", m.spec.scene_keys()},
+                  {"method", m.spec.kind},
+                  {"composition", m.spec.composition},
+                  {"order", t.order},
+                  {"symmetric", t.symmetric},
+                  {"implicit", t.implicit},
+                  {"adaptive", t.adaptive},
+                  {"composable", m.spec.composition == "none" && method_is_symmetric(m.spec)},
+                  {"group", m.group}};
+    // Every method key: its value where the method has it, else null; "own"
+    // lists the method's keys in their declared order.
+    for (const MethodKey& k : all_method_keys()) entry[k.name] = nullptr;
+    entry["own"] = json::array();
+    for (const MethodKey& k : method_flags(m.spec.kind).keys) {
+      entry["own"].push_back(k.name);
+      if (k.text) entry[k.name] = m.spec.*k.text;
+      if (k.whole) entry[k.name] = m.spec.*k.whole;
+      if (k.number) entry[k.name] = m.spec.*k.number;
+    }
+    out["methods"].push_back(entry);
   }
   out["compositions"] = json::array();
   for (const Composition& c : compositions())
@@ -250,7 +289,7 @@ void apply_override(json* scene, const std::string& assignment) {
 json validate_scene(const json& scene) {
   if (!scene.is_object()) throw SceneError("scene must be a JSON object, got " + show(scene));
   for (const auto& [key, value] : scene.items())
-    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end()) unknown_key(key, kKeys);
+    if (std::find(scene_keys().begin(), scene_keys().end(), key) == scene_keys().end()) unknown_key(key, scene_keys());
   for (const char* key : {"system", "q0", "v0", "method", "h", "steps"})
     if (!scene.contains(key)) fail(key, "missing (required)");
 
@@ -259,36 +298,24 @@ json validate_scene(const json& scene) {
   if (scene.contains("params") && !scene["params"].is_object())
     fail("params", "must be an object, got " + show(scene["params"]));
   r["method"] = one_of(scene["method"], "method", method_names());
-  r["discretization"] = scene.contains("discretization")
-                            ? one_of(scene["discretization"], "discretization", {"alpha", "symmetric"})
-                            : "alpha";
-  const double alpha = scene.contains("alpha") ? finite_number(scene["alpha"], "alpha") : 0.5;
-  if (!(alpha >= 0.0 && alpha <= 1.0)) fail("alpha", "must be in [0, 1], got " + show(scene["alpha"]));
-  r["alpha"] = alpha;
-  r["stages"] = scene.contains("stages") ? integer(scene["stages"], "stages", 2, 4) : 2L;
-  r["constraint"] =
-      scene.contains("constraint") ? one_of(scene["constraint"], "constraint", {"midpoint", "endpoint"}) : "midpoint";
+  for (const MethodKey& k : all_method_keys()) r[k.name] = method_key_value(k, scene);
   r["start"] = scene.contains("start") ? one_of(scene["start"], "start", {"predictor", "continuation"}) : "predictor";
   r["composition"] =
       scene.contains("composition") ? one_of(scene["composition"], "composition", composition_names()) : "none";
   if (r["composition"] != "none") {
     MethodSpec spec;
     spec.kind = r["method"];
-    spec.discretization = r["discretization"];
-    spec.alpha = alpha;
-    spec.stages = static_cast<int>(r["stages"].get<long>());
+    set_method_keys(&spec, r);
     if (!method_is_symmetric(spec))
       fail("composition",
            "\"" + r["composition"].get<std::string>() +
-               "\" composes only symmetric methods (mp06, discrete_gradient, spark, dla with alpha = 0.5 "
-               "or discretization \"symmetric\"), not " +
-               spec.label());
+               "\" composes only symmetric methods (\"composable\" in nhi list), not " + spec.label());
   }
   const double h = finite_number(scene["h"], "h");
   if (!(h > 0)) fail("h", "must be > 0, got " + show(scene["h"]));
   r["h"] = h;
   r["steps"] = integer(scene["steps"], "steps", 1, 10'000'000'000L);
-  const double tol = scene.contains("tolerance") ? finite_number(scene["tolerance"], "tolerance") : 1e-12;
+  const double tol = scene.contains("tolerance") ? finite_number(scene["tolerance"], "tolerance") : kDefaultTolerance;
   if (!(tol > 0 && tol < 1)) fail("tolerance", "must be in (0, 1), got " + show(scene["tolerance"]));
   r["tolerance"] = tol;
   if (!scene.contains("energy_limit")) {
