@@ -250,8 +250,8 @@ endif
 results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
     results/stability.json results/geometry.json results/fate_map.json results/fate_map_roots.json results/states.json \
     results/global_error.json results/step_costs.json \
-    $(RUNS) $(COMPANION_RUNS)
-	experiments/summarize.sh results > $@.tmp && mv $@.tmp $@
+    $(RUNS) $(COMPANION_RUNS) $(NHI)
+	experiments/summarize.sh results $(NHI) > $@.tmp && mv $@.tmp $@
 readme-tables: results/summary.md $(NHI)
 	d=$$(mktemp -d) && { $(NHI) list --markdown > $$d/list.md && \
 	  experiments/readme_tables.sh results/summary.md $$d/list.md; rc=$$?; rm -rf $$d; exit $$rc; }

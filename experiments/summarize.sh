@@ -2,8 +2,15 @@
 # Markdown tables of the study results (results/*.json -> stdout).  `make
 # reproduce` writes them to results/summary.md; experiments/readme_tables.sh
 # copies the sections README.md shows between its BEGIN/END markers.
+#
+#   experiments/summarize.sh [RESULTS_DIR [NHI]]
+#
+# NHI (default build/bin/nhi): the runner, whose `nhi list --json` gives the
+# scene classes of the decision table.
 set -euo pipefail
 R=${1:-results}
+NHI=${2:-build/bin/nhi}
+[ -x "$NHI" ] || { echo "summarize.sh: no runner $NHI (build it: make build; or pass its path)" >&2; exit 2; }
 # jq: a number to 3 significant digits (scientific when small or large), "-" for
 # null; the exponent is taken after rounding, so 0.009999 prints 0.01, not 10e-3.
 G='def g: if . == null then "-" elif . == 0 then "0" else
@@ -207,12 +214,16 @@ def targets: 1e-2, 1e-4, 1e-6, 1e-8;
 def paper_dla: startswith("dla");
 '
 # Scene classes of the decision table (Modin & Verdier's: reversible or not,
-# integrable or not); a scene not listed is a class of its own.
-CLASSES='[{"name": "reversible, integrable", "scenes": ["particle", "robot", "contact_oscillator", "rolling_disk"]},
-          {"name": "reversible, chaotic", "scenes": ["chaotic_oscillator"]},
-          {"name": "reversible flow, non-reversible maps", "scenes": ["contact_oscillator_nr"]},
-          {"name": "not reversible", "scenes": ["magnetic_particle"]},
-          {"name": "reversible, attracted to a line", "scenes": ["sleigh"]}]'
+# integrable or not): each system's "class" in `nhi list --json`, which follows
+# from the traits it declares (lib/nhi/system.hpp), its scenes in the registry's
+# order.  The classes come in this order, any other after them; a scene the
+# runner does not know is a class of its own.
+CLASS_ORDER='["reversible, integrable", "reversible, chaotic", "reversible flow, non-reversible maps",
+              "not reversible", "reversible, attracted to a line"]'
+CLASSES=$("$NHI" list --json | jq -c --argjson order "$CLASS_ORDER" '
+  [.systems[] | {class, scene: .name}] as $sys |
+  reduce ($order[], $sys[].class) as $c ([]; if index($c) then . else . + [$c] end) |
+  map(. as $c | {name: $c, scenes: [$sys[] | select(.class == $c) | .scene]}) | map(select(.scenes | length > 0))')
 # input: work_precision.json; $classes as above.
 CLS='
 def geomean: map(log) | add / length | exp;

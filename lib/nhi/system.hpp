@@ -23,6 +23,11 @@
 //   static constexpr bool reversible = true;  // L, omega invariant under (q, v) -> (q, -v)
 //   static constexpr bool integrable = true;  // ... and integrable: reversible KAM theory
 //                                             // bounds a reversible method's energy error
+//   static constexpr bool reversible_flow = true;  // the flow is reversible though L is
+//                                             // not (a gauge term): every q(t) is, the
+//                                             // methods' maps are not (default: `reversible`)
+//   static constexpr const char* behaviour = "chaotic";  // the long-time motion where
+//                                             // reversible but not integrable
 //   first_integral_names(), first_integrals(q, v)  // conserved quantities besides the energy
 //   exact_solution(q0, v0, t, &q, &v)          // a closed form (returns false where it has none)
 //   section_states(count), section_coordinate  // initial states for Poincare sections
@@ -30,6 +35,9 @@
 //   nonholonomic_momentum, momentum_equation_rhs   // a symmetry for eq. (24)
 //   reduced_flow                               // an independent exact reduced description
 //   paper_section                              // one of the paper's scenes (section 6.x)
+// reversible, integrable, reversible_flow and behaviour make a scene's "class" in
+// `nhi list --json` (catalog() in lib/src/scene.cpp), by which experiments/summarize.sh
+// groups the scenes of its decision table.
 // The pair (l, g) adds l holonomic constraints g(q) = 0: the Constrained Coordinate
 // Formulation (paper eq. 17), where Q is a submanifold g = 0 of a vector space V
 // and the configuration is a point of V (e.g. an angle as a unit vector).
@@ -65,6 +73,27 @@ template <class S, class = void>
 struct is_reversible : std::false_type {};
 template <class S>
 struct is_reversible<S, std::enable_if_t<S::reversible>> : std::true_type {};
+
+template <class S, class = void>
+struct is_integrable : std::false_type {};
+template <class S>
+struct is_integrable<S, std::enable_if_t<S::integrable>> : std::true_type {};
+
+// A reversible flow: declared, or implied by `reversible`.
+template <class S, class = void>
+struct has_reversible_flow : is_reversible<S> {};
+template <class S>
+struct has_reversible_flow<S, std::enable_if_t<S::reversible_flow>> : std::true_type {};
+
+// The long-time behaviour a scene declares (nullptr if none).
+template <class S, class = void>
+struct behaviour_of {
+  static constexpr const char* value = nullptr;
+};
+template <class S>
+struct behaviour_of<S, std::void_t<decltype(S::behaviour)>> {
+  static constexpr const char* value = S::behaviour;
+};
 
 // Reversible and integrable: the class on which Modin & Verdier (Numer. Math.
 // 145, 2020) show by reversible KAM theory that reversible methods keep the

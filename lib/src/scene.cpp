@@ -185,6 +185,14 @@ json catalog() {
     json params = json::object();
     for (const auto& p : S::parameters()) params[p.name] = sys.*(p.member);
     const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
+    // The scene's class from its declared traits (system.hpp): Modin & Verdier's
+    // reversible and integrable, refined where reversible but not integrable.
+    const char* behaviour = behaviour_of<S>::value;
+    std::string cls = "not reversible";
+    if (is_reversible<S>::value)
+      cls = std::string("reversible, ") + (is_integrable<S>::value ? "integrable" : behaviour ? behaviour : "not integrable");
+    else if (has_reversible_flow<S>::value)
+      cls = "reversible flow, non-reversible maps";
     out["systems"].push_back({{"name", S::name},
                               {"n", S::n},
                               {"m", S::m},
@@ -192,6 +200,10 @@ json catalog() {
                               {"q0", std::vector<double>(q0.data(), q0.data() + S::n)},
                               {"v0", std::vector<double>(v0.data(), v0.data() + S::n)},
                               {"reversible", is_reversible<S>::value},
+                              {"integrable", is_integrable<S>::value},
+                              {"reversible_flow", has_reversible_flow<S>::value},
+                              {"behaviour", behaviour ? json(behaviour) : json(nullptr)},
+                              {"class", cls},
                               {"separable", is_separable<S>::value}});
   });
   // Every method the studies run, with the traits it declares (on the first

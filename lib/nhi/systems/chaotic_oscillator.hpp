@@ -27,6 +27,7 @@ struct ChaoticOscillator {
   static constexpr int m = 1;
   static constexpr const char* name = "chaotic_oscillator";
   static constexpr bool reversible = true;
+  static constexpr const char* behaviour = "chaotic";
   static constexpr bool separable = true;
 
   double epsilon = 1.0;

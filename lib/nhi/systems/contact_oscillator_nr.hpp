@@ -28,6 +28,8 @@ struct ContactOscillatorNR {
   static constexpr const char* name = "contact_oscillator_nr";
   // Integrable like contact_oscillator, but not reversible under (q, v) -> (q, -v);
   // L' = 1/2 |v|^2 + a(q) . v - U(q) with a = (0, 0, sin z): not `separable`.
+  // Its trajectories are contact_oscillator's, so the flow is reversible; the maps are not.
+  static constexpr bool reversible_flow = true;
 
   double epsilon = 0.3;
 

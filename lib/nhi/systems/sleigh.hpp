@@ -53,6 +53,8 @@ struct Sleigh {
   static constexpr const char* name = "sleigh";
   // L and omega are invariant under (q, v) -> (q, -v); not integrable (see above).
   static constexpr bool reversible = true;
+  // With g = 0 every motion tends to a straight line (w -> 0, see above).
+  static constexpr const char* behaviour = "attracted to a line";
   static constexpr bool separable = true;  // M constant, U = m g y
 
   double mass = 1.0;
