@@ -14,6 +14,9 @@ DEB_PACKAGES := cmake ninja-build g++ make libeigen3-dev libceres-dev libsundial
 BUILD ?= build
 NHI := $(BUILD)/bin/nhi
 JOBS ?= 2
+# The figures' shared look, and each method's line style as the methods declare
+# it (nhi list --gnuplot), rewritten only when it changes.
+STYLE := plots/style.gp plots/method_styles.gp
 
 .PHONY: all deps build install test test-sanitize examples fuzz reproduce figures readme-tables sweep sweep-results check-sweep \
         sweep-scaling clean
@@ -153,13 +156,13 @@ results/%_mp06.json: experiments/scenes/%.json $(NHI)
 	$(NHI) run $< --set method=mp06 -o $@
 results/%_mp06tj.json: experiments/scenes/%.json $(NHI)
 	$(NHI) run $< --set method=mp06 --set composition=triple_jump -o $@
-plots/fig1b_particle_energy.png: plots/energy_new.gp plots/style.gp $(filter results/particle_fig12_%,$(RUNS) $(COMPANION_RUNS))
+plots/fig1b_particle_energy.png: plots/energy_new.gp $(STYLE) $(filter results/particle_fig12_%,$(RUNS) $(COMPANION_RUNS))
 	$(call PLOT,results/particle_fig12,Figure 1b: nonholonomic particle,1)
-plots/fig2b_particle_constraint.png: plots/constraint_new.gp plots/style.gp $(filter results/particle_fig12_%,$(RUNS) $(COMPANION_RUNS))
+plots/fig2b_particle_constraint.png: plots/constraint_new.gp $(STYLE) $(filter results/particle_fig12_%,$(RUNS) $(COMPANION_RUNS))
 	$(call PLOT,results/particle_fig12,Figure 2b: nonholonomic particle,1)
-plots/fig3b_robot_energy.png: plots/energy_new.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS) $(COMPANION_RUNS))
+plots/fig3b_robot_energy.png: plots/energy_new.gp $(STYLE) $(filter results/robot_fig34_%,$(RUNS) $(COMPANION_RUNS))
 	$(call PLOT,results/robot_fig34,Figure 3b: mobile robot,2)
-plots/fig4b_robot_constraint.png: plots/constraint_new.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS) $(COMPANION_RUNS))
+plots/fig4b_robot_constraint.png: plots/constraint_new.gp $(STYLE) $(filter results/robot_fig34_%,$(RUNS) $(COMPANION_RUNS))
 	$(call PLOT,results/robot_fig34,Figure 4b: mobile robot,2)
 
 # One figure per study and registered scene (see STUDY below).
@@ -170,19 +173,22 @@ GEOMETRY_FIGURES := plots/geometry_momentum.png plots/geometry_extrinsic.png
 
 figures: $(FIGURES) $(COMPANION_FIGURES) $(STUDY_TARGETS) $(GEOMETRY_FIGURES) fate-map-figures results/summary.md readme-tables
 
+plots/method_styles.gp: $(NHI)
+	$(NHI) list --gnuplot > $@.tmp && { cmp -s $@.tmp $@ && rm $@.tmp || mv $@.tmp $@; }
+
 # results/SCENE_METHOD.json from experiments/scenes/SCENE.json
 .SECONDEXPANSION:
 $(RUNS): results/%.json: experiments/scenes/$$(word 1,$$(subst _, ,$$*))_$$(word 2,$$(subst _, ,$$*)).json $(NHI)
 	$(NHI) run $< --set method=$(lastword $(subst _, ,$*)) -o $@
 
 PLOT = gnuplot -e "stem='$(1)'; out='$@'; label='$(2)'; m=$(3)" $<
-plots/fig1_particle_energy.png: plots/energy.gp plots/style.gp $(filter results/particle_fig12_%,$(RUNS))
+plots/fig1_particle_energy.png: plots/energy.gp $(STYLE) $(filter results/particle_fig12_%,$(RUNS))
 	$(call PLOT,results/particle_fig12,Figure 1: nonholonomic particle,1)
-plots/fig2_particle_constraint.png: plots/constraint.gp plots/style.gp $(filter results/particle_fig12_%,$(RUNS))
+plots/fig2_particle_constraint.png: plots/constraint.gp $(STYLE) $(filter results/particle_fig12_%,$(RUNS))
 	$(call PLOT,results/particle_fig12,Figure 2: nonholonomic particle,1)
-plots/fig3_robot_energy.png: plots/energy.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS))
+plots/fig3_robot_energy.png: plots/energy.gp $(STYLE) $(filter results/robot_fig34_%,$(RUNS))
 	$(call PLOT,results/robot_fig34,Figure 3: mobile robot,2)
-plots/fig4_robot_constraint.png: plots/constraint.gp plots/style.gp $(filter results/robot_fig34_%,$(RUNS))
+plots/fig4_robot_constraint.png: plots/constraint.gp $(STYLE) $(filter results/robot_fig34_%,$(RUNS))
 	$(call PLOT,results/robot_fig34,Figure 4: mobile robot,2)
 
 # ---- Studies (issue 4): one executable, one JSON, one script each -------------
@@ -198,7 +204,7 @@ $(2): results/$(1).json
 # The script reads everything it needs from the result in one jq pass
 # (jq_script, plots/style.gp).  A failure of jq or gnuplot fails the target;
 # gnuplot's "Skipping data file" warnings (a series empty for a scene) are dropped.
-plots/$(1)_%.png: plots/$(1).gp plots/style.gp results/$(1).json
+plots/$(1)_%.png: plots/$(1).gp $(STYLE) results/$(1).json
 	log=$$$$(mktemp) && { gnuplot -e "file='results/$(1).json'; scene='$$*'; out='$$@'" $$< > $$$$log 2>&1; \
 	  rc=$$$$?; grep -v Skipping $$$$log; rm -f $$$$log; exit $$$$rc; }
 endef
@@ -216,7 +222,7 @@ results/convergence.json results/stability.json results/geometry.json results/po
 # ---- The geometry of the discrete flow (issue 5): eq. 24, eq. 17, Remark 3.3 ---
 .PHONY: study-geometry
 study-geometry: $(GEOMETRY_FIGURES)
-plots/geometry_%.png: plots/geometry_%.gp plots/style.gp results/geometry.json
+plots/geometry_%.png: plots/geometry_%.gp $(STYLE) results/geometry.json
 	log=$$(mktemp) && { gnuplot -e "file='results/geometry.json'; out='$@'" $< > $$log 2>&1; \
 	  rc=$$?; grep -v Skipping $$log; rm -f $$log; exit $$rc; }
 
@@ -278,7 +284,7 @@ endif
 .PHONY: fate-map-figures
 fate-map-figures: results/fate_map.json
 	$(MAKE) --no-print-directory $$(jq -r '.scenes | keys_unsorted[] | "plots/fate_map_" + . + ".png"' $<)
-plots/fate_map_%.png: plots/fate_map.gp plots/style.gp results/fate_map.json
+plots/fate_map_%.png: plots/fate_map.gp $(STYLE) results/fate_map.json
 	gnuplot -e "file='results/fate_map.json'; scene='$*'; out='$@'" $<
 # Its run time with 1, 2 and 4 ranks of one thread each (4 oversubscribes
 # this machine's two cores: a correctness check, not a speed-up).

@@ -1,6 +1,6 @@
 // nhi: run one scene, or list what the library has.
 //   nhi run SCENE.json [--set key=value]... [-o OUT.json]
-//   nhi list [--markdown | --json]   systems (parameters, defaults), methods, compositions
+//   nhi list [--markdown | --json | --gnuplot]   systems (parameters, defaults), methods, compositions
 //   nhi --version                    version, git revision, compiler, build flags
 // Exit status: 0 run ok; 3 run ended with status "failed" (the result is still
 // written); 2 bad input (an unknown subcommand too) or unwritable output
@@ -135,6 +135,19 @@ std::string list_markdown(const nhi::json& c) {
   return os.str();
 }
 
+// plots/method_styles.gp: each study method's declared line style by its label.
+std::string list_gnuplot(const nhi::json& c) {
+  std::ostringstream os;
+  os << "# Written by `nhi list --gnuplot` (make figures) from the line style each method declares\n"
+        "# for its study entries (StudyEntry::style in its header): do not edit.  plots/style.gp\n"
+        "# loads it and defines the styles and other_ls() for labels that are not methods.\n"
+        "method_ls(label) = \\\n";
+  for (const auto& m : c["methods"])
+    os << "  label eq " << m["label"].dump() << " ? " << m["style"] << " : \\\n";
+  os << "  other_ls(label)\n";
+  return os.str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -150,9 +163,12 @@ int main(int argc, char** argv) {
   run->add_option("--set", sets, "Override one scene key: key=JSON value (or a bare string)")->allow_extra_args(false);
   run->add_option("-o,--output", out_path, "Result file (default: standard output)");
   auto* list = app.add_subcommand("list", "List the systems (parameters, defaults), methods and compositions");
-  bool markdown = false, as_json = false;
+  bool markdown = false, as_json = false, gnuplot = false;
   auto* md_flag = list->add_flag("--markdown", markdown, "As Markdown tables (the README's)");
-  list->add_flag("--json", as_json, "As JSON")->excludes(md_flag);
+  auto* json_flag = list->add_flag("--json", as_json, "As JSON")->excludes(md_flag);
+  list->add_flag("--gnuplot", gnuplot, "The methods' line styles for the figures (plots/method_styles.gp)")
+      ->excludes(md_flag)
+      ->excludes(json_flag);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -171,7 +187,10 @@ int main(int argc, char** argv) {
   }
   if (list->parsed()) {
     const nhi::json c = nhi::catalog();
-    std::cout << (as_json ? c.dump(2) + "\n" : markdown ? list_markdown(c) : list_text(c));
+    std::cout << (as_json    ? c.dump(2) + "\n"
+                  : markdown ? list_markdown(c)
+                  : gnuplot  ? list_gnuplot(c)
+                             : list_text(c));
     return 0;
   }
 

@@ -325,27 +325,32 @@ inline long fault_cell(const char* var) {
   return v ? std::atol(v) : -1;
 }
 
-// Every cell's JSON, on every rank, in cell order.  This rank computes its
-// cells on o.threads threads, costliest first; under MPI the ranks then exchange results.  A
-// cell that throws, or an interrupt on any rank, ends the study on every rank
-// (exit 1, naming the cell, or 130), before anything is written.
-inline std::vector<json> map_cells(const Options& o, const Cells& c) {
+namespace detail {
+
+// The ranks that run the cells (timed cells: one per node, said once).
+inline std::vector<int> cell_ranks(const Cells& c) {
   Cluster& cl = Cluster::get();
   std::vector<int> ranks;
-  if (c.timed) {
-    ranks = cl.node_leaders();
-    static bool told = false;
-    if (cl.root() && !told && ranks.size() < static_cast<size_t>(cl.size())) {
-      std::fprintf(stderr, "%s: timed cells run on one rank per node (%zu of %d ranks); the others wait\n",
-                   c.label.c_str(), ranks.size(), cl.size());
-      told = true;
-    }
-  } else {
+  if (!c.timed) {
     for (int r = 0; r < cl.size(); ++r) ranks.push_back(r);
+    return ranks;
   }
+  ranks = cl.node_leaders();
+  static bool told = false;
+  if (cl.root() && !told && ranks.size() < static_cast<size_t>(cl.size())) {
+    std::fprintf(stderr, "%s: timed cells run on one rank per node (%zu of %d ranks); the others wait\n",
+                 c.label.c_str(), ranks.size(), cl.size());
+    told = true;
+  }
+  return ranks;
+}
+
+// This rank's cells, costliest first (so that the threads finish together).
+inline std::vector<size_t> own_cells(const Cells& c) {
+  Cluster& cl = Cluster::get();
   std::vector<double> cost(c.count);
   for (size_t i = 0; i < c.count; ++i) cost[i] = c.cost(i);
-  const std::vector<int> owner = assign_cells(cost, ranks);
+  const std::vector<int> owner = assign_cells(cost, cell_ranks(c));
   std::vector<size_t> mine;
   RankStats& st = rank_stats();
   for (size_t i = 0; i < c.count; ++i)
@@ -353,18 +358,32 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
       mine.push_back(i);
       st.estimated_cost += cost[i];
     }
-  // Costliest first, so that the threads finish together.
   std::stable_sort(mine.begin(), mine.end(), [&](size_t a, size_t b) { return cost[a] > cost[b]; });
-  std::vector<json> out(c.count);
-  std::vector<std::pair<size_t, std::string>> errors;
+  return mine;
+}
+
+using CellErrors = std::vector<std::pair<size_t, std::string>>;
+
+// Run `mine` on o.threads threads into out; the first cell that throws stops
+// the others.  Fault injection for the tests: NHI_STUDY_FAIL_CELL (throws),
+// NHI_STUDY_KILL_CELL (SIGKILL); NHI_STUDY_CELL_TIMES=1: each cell's wall
+// seconds on stderr (where a study spends its time).
+inline CellErrors run_own_cells(const Options& o, const Cells& c, const std::vector<size_t>& mine,
+                                std::vector<json>* out) {
+  Cluster& cl = Cluster::get();
+  CellErrors errors;
   std::mutex m;
   std::atomic<bool> failed{false};
   const std::string label = cl.parallel() ? c.label + " (rank 0 of " + std::to_string(cl.size()) + ")" : c.label;
   Progress progress(label, static_cast<long>(mine.size()));
   const auto t0 = std::chrono::steady_clock::now();
   const long fail_cell = fault_cell("NHI_STUDY_FAIL_CELL"), kill_cell = fault_cell("NHI_STUDY_KILL_CELL");
-  // NHI_STUDY_CELL_TIMES=1: each cell's wall seconds on stderr (where a study spends its time).
   const bool cell_times = std::getenv("NHI_STUDY_CELL_TIMES") != nullptr;
+  auto fail = [&](size_t i, std::string what) {
+    std::lock_guard<std::mutex> lock(m);
+    errors.emplace_back(i, std::move(what));
+    failed = true;
+  };
   parallel_for(
       mine.size(), o.threads,
       [&](size_t k) {
@@ -374,69 +393,92 @@ inline std::vector<json> map_cells(const Options& o, const Cells& c) {
           if (static_cast<long>(i) == kill_cell) std::raise(SIGKILL);
           if (static_cast<long>(i) == fail_cell) throw std::runtime_error("injected failure (NHI_STUDY_FAIL_CELL)");
           const auto c0 = std::chrono::steady_clock::now();
-          out[i] = c.run(i);
+          (*out)[i] = c.run(i);
           if (cell_times)
             std::fprintf(stderr, "%s: cell %zu (%s): %.3f s\n", c.label.c_str(), i, c.name(i).c_str(),
                          std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count());
         } catch (const std::exception& e) {
-          std::lock_guard<std::mutex> lock(m);
-          errors.emplace_back(i, e.what());
-          failed = true;
+          fail(i, e.what());
         } catch (...) {
-          std::lock_guard<std::mutex> lock(m);
-          errors.emplace_back(i, "unknown exception");
-          failed = true;
+          fail(i, "unknown exception");
         }
       },
       cl.root() && !mine.empty() ? &progress : nullptr);
+  RankStats& st = rank_stats();
   st.busy_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   st.cells += static_cast<long>(mine.size());
-  bool interrupted = nhi::interrupt_flag().load();
-  if (cl.parallel()) {
-    json part = {{"cells", json::array()}, {"errors", json::array()}, {"interrupted", interrupted}};
-    if (!failed && !interrupted)
-      for (const size_t i : mine) part["cells"].push_back({i, std::move(out[i])});
-    for (const auto& e : errors) part["errors"].push_back({e.first, e.second});
-    const std::vector<uint8_t> bytes = json::to_cbor(part);
-    // Ranks without cells (a timed phase) wait asleep, not polling a core
-    // that a timed rank of their node may be using.
-    cl.quiet_barrier();
-    const std::vector<std::string> all = cl.all_gather(std::string(bytes.begin(), bytes.end()));
-    errors.clear();
-    std::vector<int> received(c.count, 0);
-    for (const std::string& b : all) {
-      const json p = json::from_cbor(b);
-      interrupted = interrupted || p["interrupted"].get<bool>();
-      for (const json& e : p["errors"]) errors.emplace_back(e[0].get<size_t>(), e[1].get<std::string>());
-      for (const json& cell : p["cells"]) {
-        const size_t i = cell[0].get<size_t>();
-        out[i] = cell[1];
-        ++received[i];
-      }
+  return errors;
+}
+
+// Under MPI: every rank's cells (and errors, and interrupts) to every rank;
+// each cell must arrive exactly once.
+inline void gather_cells(const Cells& c, const std::vector<size_t>& mine, std::vector<json>* out, CellErrors* errors,
+                         bool* interrupted) {
+  Cluster& cl = Cluster::get();
+  json part = {{"cells", json::array()}, {"errors", json::array()}, {"interrupted", *interrupted}};
+  if (errors->empty() && !*interrupted)
+    for (const size_t i : mine) part["cells"].push_back({i, std::move((*out)[i])});
+  for (const auto& e : *errors) part["errors"].push_back({e.first, e.second});
+  const std::vector<uint8_t> bytes = json::to_cbor(part);
+  // Ranks without cells (a timed phase) wait asleep, not polling a core
+  // that a timed rank of their node may be using.
+  cl.quiet_barrier();
+  const std::vector<std::string> all = cl.all_gather(std::string(bytes.begin(), bytes.end()));
+  errors->clear();
+  std::vector<int> received(c.count, 0);
+  for (const std::string& b : all) {
+    const json p = json::from_cbor(b);
+    *interrupted = *interrupted || p["interrupted"].get<bool>();
+    for (const json& e : p["errors"]) errors->emplace_back(e[0].get<size_t>(), e[1].get<std::string>());
+    for (const json& cell : p["cells"]) {
+      const size_t i = cell[0].get<size_t>();
+      (*out)[i] = cell[1];
+      ++received[i];
     }
-    // Every cell exactly once, or the ranks disagreed on the owner table
-    // (their cost tables differ: another libm on another node?).
-    if (!interrupted && errors.empty())
-      for (size_t i = 0; i < c.count; ++i)
-        if (received[i] != 1) {
-          errors.emplace_back(
-              i, "received from " + std::to_string(received[i]) + " ranks (the ranks disagree on which rank runs it)");
-          break;
-        }
   }
+  // Every cell exactly once, or the ranks disagreed on the owner table
+  // (their cost tables differ: another libm on another node?).
+  if (!*interrupted && errors->empty())
+    for (size_t i = 0; i < c.count; ++i)
+      if (received[i] != 1) {
+        errors->emplace_back(
+            i, "received from " + std::to_string(received[i]) + " ranks (the ranks disagree on which rank runs it)");
+        break;
+      }
+}
+
+// An interrupt (exit 130) or a failed cell (exit 1, naming it) ends the study
+// on every rank before anything is written.
+inline void end_if_failed(const Cells& c, CellErrors errors, bool interrupted) {
+  Cluster& cl = Cluster::get();
   if (interrupted) {
     if (cl.root()) std::fprintf(stderr, "%sstudy: interrupted; nothing written\n", end_progress_line());
     cl.exit_all(130);
   }
-  if (!errors.empty()) {
-    std::sort(errors.begin(), errors.end());
-    if (cl.root())
-      for (const auto& e : errors)
-        std::fprintf(stderr, "%sstudy: %s: %s failed: %s\n", end_progress_line(), c.label.c_str(),
-                     c.name(e.first).c_str(), e.second.c_str());
-    if (cl.root()) std::fprintf(stderr, "study: failed; nothing written\n");
-    cl.exit_all(1);
+  if (errors.empty()) return;
+  std::sort(errors.begin(), errors.end());
+  if (cl.root()) {
+    for (const auto& e : errors)
+      std::fprintf(stderr, "%sstudy: %s: %s failed: %s\n", end_progress_line(), c.label.c_str(),
+                   c.name(e.first).c_str(), e.second.c_str());
+    std::fprintf(stderr, "study: failed; nothing written\n");
   }
+  cl.exit_all(1);
+}
+
+}  // namespace detail
+
+// Every cell's JSON, on every rank, in cell order.  This rank computes its
+// cells on o.threads threads, costliest first; under MPI the ranks then exchange results.  A
+// cell that throws, or an interrupt on any rank, ends the study on every rank
+// (exit 1, naming the cell, or 130), before anything is written.
+inline std::vector<json> map_cells(const Options& o, const Cells& c) {
+  const std::vector<size_t> mine = detail::own_cells(c);
+  std::vector<json> out(c.count);
+  detail::CellErrors errors = detail::run_own_cells(o, c, mine, &out);
+  bool interrupted = nhi::interrupt_flag().load();
+  if (Cluster::get().parallel()) detail::gather_cells(c, mine, &out, &errors, &interrupted);
+  detail::end_if_failed(c, std::move(errors), interrupted);
   return out;
 }
 

@@ -122,18 +122,17 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// The command line: the grid (h, parameter values, states, T, --roots) and
+// the swept parameter's name.
+Grid parse_grid(int argc, char** argv, study::Options* opt, std::string* param) {
   CLI::App app{"Fate map: stability over h x epsilon x methods x initial states (the contact oscillators)"};
-  study::Options opt;
-  study::add_options(app, opt);
+  study::add_options(app, *opt);
   Grid g;
-  std::string param = "epsilon";
+  *param = "epsilon";
   g.values = {0.1, 0.3, 1.0, 3.0};
   double h_min = 0.05, h_max = 5.0;
   int per_decade = 20;
-  app.add_option("--param", param, "The swept system parameter");
+  app.add_option("--param", *param, "The swept system parameter");
   app.add_option("--values", g.values, "Its values")->delimiter(',');
   app.add_option("--states", g.states, "Initial states per (scene, value, method, h)")->check(CLI::Range(2, 100000));
   app.add_option("--T", g.T, "Final time of every run")->check(CLI::PositiveNumber);
@@ -148,17 +147,26 @@ int main(int argc, char** argv) {
   }
   const int points = static_cast<int>(std::floor(per_decade * std::log10(h_max / h_min) + 1e-9));
   for (int i = 0; i <= points; ++i) g.hs.push_back(h_min * std::pow(10.0, double(i) / per_decade));
-  g.methods = study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
-  if (g.roots) {  // (implicit or not is a method's trait for every system: asked of the particle's)
-    std::vector<nhi::StudyMethod> implicit;
-    for (const auto& m : g.methods)
-      if (nhi::visit_scene(
-              nhi::validate_scene(study::scene(opt, study::scene_names(opt).front())),
-              [&](const auto& sys, const auto&, const auto&) { return nhi::method_traits(sys, m.spec).implicit; }))
-        implicit.push_back(m);
-    g.methods = implicit;
-  }
+  return g;
+}
 
+// The fixed-step "main" methods; with --roots the implicit ones only
+// (implicit or not is a method's trait for every system: asked of the first scene's).
+std::vector<nhi::StudyMethod> grid_methods(const study::Options& opt, bool roots) {
+  const auto methods =
+      study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
+  if (!roots) return methods;
+  std::vector<nhi::StudyMethod> implicit;
+  for (const auto& m : methods)
+    if (nhi::visit_scene(
+            nhi::validate_scene(study::scene(opt, study::scene_names(opt).front())),
+            [&](const auto& sys, const auto&, const auto&) { return nhi::method_traits(sys, m.spec).implicit; }))
+      implicit.push_back(m);
+  return implicit;
+}
+
+// The scenes with a section family and the parameter, each validated at every value.
+void grid_scenes(const study::Options& opt, const std::string& param, Grid* g) {
   try {
     for (const std::string& name : study::scene_names(opt)) {
       const json sc = study::scene(opt, name);
@@ -170,39 +178,145 @@ int main(int argc, char** argv) {
       });
       if (!fits) continue;
       std::vector<json> at;
-      for (const double v : g.values) {
+      for (const double v : g->values) {
         json s = sc;
         s["params"][param] = v;
         at.push_back(nhi::validate_scene(s));
       }
-      g.scenes.push_back(name);
-      g.scene_at.push_back(at);
+      g->scenes.push_back(name);
+      g->scene_at.push_back(at);
     }
   } catch (const std::exception& e) {
     std::cerr << "study_fate_map: error: " << e.what() << "\n";
     study::Cluster::get().exit_all(2);
   }
-  if (g.scenes.empty()) {
+  if (g->scenes.empty()) {
     std::cerr << "study_fate_map: no scene has a section family and the parameter \"" << param << "\"\n";
     study::Cluster::get().exit_all(2);
   }
+}
 
+// Every run of the grid, one cell each.
+study::Cells grid_cells(const Grid& g, const std::string& param) {
   study::Cells cells;
   cells.label = "fate map";
   cells.count = g.count();
-  cells.run = [&](size_t i) { return run_cell(g, i); };
-  cells.cost = [&](size_t i) {
+  cells.run = [&g](size_t i) { return run_cell(g, i); };
+  cells.cost = [&g](size_t i) {
     const auto ix = g.split(i);
     // (--roots: a checked step costs about 2 + h / continuation_dh solves, a continued one one fewer)
     const double solves = g.roots ? 3 + 2 * g.hs[ix[3]] / nhi::SolverOptions{}.continuation_dh : 1.0;
     return g.T / g.hs[ix[3]] * study::step_weight(g.methods[ix[2]].spec) * solves;
   };
-  cells.name = [&](size_t i) {
+  cells.name = [&g, param](size_t i) {
     const auto ix = g.split(i);
     return g.scenes[ix[0]] + " " + param + " = " + std::to_string(g.values[ix[1]]) + ", " + g.methods[ix[2]].label() +
            " at h = " + std::to_string(g.hs[ix[3]]) + ", initial state " + std::to_string(ix[4]);
   };
-  const std::vector<json> runs = study::map_cells(opt, cells);
+  return cells;
+}
+
+// The fates of one method over the grid of h (one scene and value), from the
+// runs in index order starting at runs[*i] (advanced past them).
+json method_fates(const Grid& g, size_t m, const std::vector<json>& runs, size_t* i, long* total_steps) {
+  json fates = json::array(), stable = json::array(), energy = json::array(), solve = json::array(),
+       nonfinite = json::array(), med = json::array();
+  json largest_all = nullptr, largest_half = nullptr;
+  bool all_broken = false, half_broken = false;
+  // --roots: the root letters, the continued runs' fates and their limits.
+  json root_letters = json::array(), other_root = json::array(), fates_c = json::array(), stable_c = json::array();
+  json largest_all_c = nullptr, largest_half_c = nullptr;
+  bool all_broken_c = false, half_broken_c = false;
+  for (size_t j = 0; j < g.hs.size(); ++j) {
+    std::string f, roots, fc;
+    std::vector<double> rel;
+    int c[4] = {0, 0, 0, 0}, others = 0, stable_cont = 0;
+    for (int k = 0; k < g.states; ++k, ++*i) {
+      const json& r = runs[*i];
+      const char letter = r[0].get<std::string>()[0];
+      f += letter;
+      c[letter == 's' ? 0 : letter == 'e' ? 1 : letter == 'f' ? 2 : 3]++;
+      if (std::isfinite(r[1].get<double>())) rel.push_back(r[1].get<double>());
+      *total_steps += r[2].get<long>();
+      if (g.roots) {
+        roots += r[3].get<std::string>();
+        others += r[3] != "c";
+        fc += r[4].get<std::string>();
+        stable_cont += r[4] == "s";
+        *total_steps += r[6].get<long>();
+      }
+    }
+    if (g.roots) {
+      root_letters.push_back(roots);
+      other_root.push_back(others);
+      fates_c.push_back(fc);
+      stable_c.push_back(stable_cont);
+      if (stable_cont != g.states) all_broken_c = true;
+      if (2 * stable_cont < g.states) half_broken_c = true;
+      if (!all_broken_c) largest_all_c = g.hs[j];
+      if (!half_broken_c) largest_half_c = g.hs[j];
+    }
+    fates.push_back(f);
+    stable.push_back(c[0]);
+    energy.push_back(c[1]);
+    solve.push_back(c[2]);
+    nonfinite.push_back(c[3]);
+    const double md = median(rel);
+    med.push_back(std::isfinite(md) ? json(md) : json(nullptr));
+    if (c[0] != g.states) all_broken = true;
+    if (2 * c[0] < g.states) half_broken = true;
+    if (!all_broken) largest_all = g.hs[j];
+    if (!half_broken) largest_half = g.hs[j];
+  }
+  json entry = {{"label", g.methods[m].label()},
+                {"fates", fates},
+                {"stable", stable},
+                {"energy", energy},
+                {"solve", solve},
+                {"non_finite", nonfinite},
+                {"median_max_rel_energy_error", med},
+                {"largest_h_all_stable", largest_all},
+                {"largest_h_half_stable", largest_half}};
+  if (g.roots) {
+    entry["roots"] = root_letters;
+    entry["other_root"] = other_root;
+    entry["fates_continued"] = fates_c;
+    entry["stable_continued"] = stable_c;
+    entry["largest_h_all_stable_continued"] = largest_all_c;
+    entry["largest_h_half_stable_continued"] = largest_half_c;
+  }
+  return entry;
+}
+
+// What the result's numbers mean.
+json grid_config(const Grid& g, const std::string& param) {
+  return json{{"param", param},
+              {"values", g.values},
+              {"h", g.hs},
+              {"states", g.states},
+              {"T", g.T},
+              {"initial_states", "sys.section_states(states): one energy level, z0 spread over +-0.9 sqrt 2"},
+              {"fates",
+               "s: stable (reached T, |E - E0| <= |E0| throughout); e: |E - E0| passed |E0| (stopped there); f: a "
+               "step solve did not converge; n: non-finite state or energy"},
+              {"largest_h_all_stable", "largest grid h such that at every grid h up to it every run is stable"},
+              {"largest_h_half_stable", "the same with at least half the runs stable"},
+              {"roots", g.roots},
+              {"root_letters",
+               "--roots: c every step took the root continued from h -> 0; o some step took another; x some step "
+               "had no continued root. fates_continued: the runs whose every step starts from the continued root; "
+               "other_root: states whose run with the method's own start left the continued root"}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  study::Options opt;
+  std::string param;
+  Grid g = parse_grid(argc, argv, &opt, &param);
+  g.methods = grid_methods(opt, g.roots);
+  grid_scenes(opt, param, &g);
+  const std::vector<json> runs = study::map_cells(opt, grid_cells(g, param));
 
   long total_steps = 0;
   json scenes = json::object();
@@ -211,98 +325,13 @@ int main(int argc, char** argv) {
     json by_value = json::array();
     for (size_t e = 0; e < g.values.size(); ++e) {
       json ms = json::array();
-      for (size_t m = 0; m < g.methods.size(); ++m) {
-        json fates = json::array(), stable = json::array(), energy = json::array(), solve = json::array(),
-             nonfinite = json::array(), med = json::array();
-        json largest_all = nullptr, largest_half = nullptr;
-        bool all_broken = false, half_broken = false;
-        // --roots: the root letters, the continued runs' fates and their limits.
-        json root_letters = json::array(), other_root = json::array(), fates_c = json::array(),
-             stable_c = json::array();
-        json largest_all_c = nullptr, largest_half_c = nullptr;
-        bool all_broken_c = false, half_broken_c = false;
-        for (size_t j = 0; j < g.hs.size(); ++j) {
-          std::string f, roots, fc;
-          std::vector<double> rel;
-          int c[4] = {0, 0, 0, 0}, others = 0, stable_cont = 0;
-          for (int k = 0; k < g.states; ++k, ++i) {
-            const json& r = runs[i];
-            const char letter = r[0].get<std::string>()[0];
-            f += letter;
-            c[letter == 's' ? 0 : letter == 'e' ? 1 : letter == 'f' ? 2 : 3]++;
-            if (std::isfinite(r[1].get<double>())) rel.push_back(r[1].get<double>());
-            total_steps += r[2].get<long>();
-            if (g.roots) {
-              roots += r[3].get<std::string>();
-              others += r[3] != "c";
-              fc += r[4].get<std::string>();
-              stable_cont += r[4] == "s";
-              total_steps += r[6].get<long>();
-            }
-          }
-          if (g.roots) {
-            root_letters.push_back(roots);
-            other_root.push_back(others);
-            fates_c.push_back(fc);
-            stable_c.push_back(stable_cont);
-            if (stable_cont != g.states) all_broken_c = true;
-            if (2 * stable_cont < g.states) half_broken_c = true;
-            if (!all_broken_c) largest_all_c = g.hs[j];
-            if (!half_broken_c) largest_half_c = g.hs[j];
-          }
-          fates.push_back(f);
-          stable.push_back(c[0]);
-          energy.push_back(c[1]);
-          solve.push_back(c[2]);
-          nonfinite.push_back(c[3]);
-          const double md = median(rel);
-          med.push_back(std::isfinite(md) ? json(md) : json(nullptr));
-          if (c[0] != g.states) all_broken = true;
-          if (2 * c[0] < g.states) half_broken = true;
-          if (!all_broken) largest_all = g.hs[j];
-          if (!half_broken) largest_half = g.hs[j];
-        }
-        json entry = {{"label", g.methods[m].label()},
-                      {"fates", fates},
-                      {"stable", stable},
-                      {"energy", energy},
-                      {"solve", solve},
-                      {"non_finite", nonfinite},
-                      {"median_max_rel_energy_error", med},
-                      {"largest_h_all_stable", largest_all},
-                      {"largest_h_half_stable", largest_half}};
-        if (g.roots) {
-          entry["roots"] = root_letters;
-          entry["other_root"] = other_root;
-          entry["fates_continued"] = fates_c;
-          entry["stable_continued"] = stable_c;
-          entry["largest_h_all_stable_continued"] = largest_all_c;
-          entry["largest_h_half_stable_continued"] = largest_half_c;
-        }
-        ms.push_back(entry);
-      }
+      for (size_t m = 0; m < g.methods.size(); ++m) ms.push_back(method_fates(g, m, runs, &i, &total_steps));
       by_value.push_back({{"value", g.values[e]}, {"methods", ms}});
     }
     scenes[g.scenes[s]] = {{"scene", g.scene_at[s][0]}, {"by_value", by_value}};
   }
   json result = {{"study", "fate_map"},
-                 {"config",
-                  {{"param", param},
-                   {"values", g.values},
-                   {"h", g.hs},
-                   {"states", g.states},
-                   {"T", g.T},
-                   {"initial_states", "sys.section_states(states): one energy level, z0 spread over +-0.9 sqrt 2"},
-                   {"fates",
-                    "s: stable (reached T, |E - E0| <= |E0| throughout); e: |E - E0| passed |E0| (stopped there); f: a "
-                    "step solve did not converge; n: non-finite state or energy"},
-                   {"largest_h_all_stable", "largest grid h such that at every grid h up to it every run is stable"},
-                   {"largest_h_half_stable", "the same with at least half the runs stable"},
-                   {"roots", g.roots},
-                   {"root_letters",
-                    "--roots: c every step took the root continued from h -> 0; o some step took another; x some step "
-                    "had no continued root. fates_continued: the runs whose every step starts from the continued root; "
-                    "other_root: states whose run with the method's own start left the continued root"}}},
+                 {"config", grid_config(g, param)},
                  {"size",
                   {{"runs", g.count()},
                    {"steps", total_steps},

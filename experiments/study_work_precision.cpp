@@ -89,8 +89,8 @@ long odeint_run(const S& sys, const Vec<double, S::n>& q0, const Vec<double, S::
     obs(t, Vec<double, n>(Eigen::Map<const Vec<double, n>>(y.data())),
         Vec<double, n>(Eigen::Map<const Vec<double, n>>(y.data() + n)));
   };
-  odeint::integrate_adaptive(odeint::make_controlled<Stepper>(tol, tol), f, x, 0.0, T, nhi::EmbeddedRkOptions{}.first_step,
-                             o);
+  odeint::integrate_adaptive(odeint::make_controlled<Stepper>(tol, tol), f, x, 0.0, T,
+                             nhi::EmbeddedRkOptions{}.first_step, o);
   return rhs;
 }
 
@@ -102,7 +102,8 @@ struct Config {
 // Is this configuration also run to kT_long (see there)?
 template <class S>
 bool long_run(const S& sys, const Config& c) {
-  if (c.method.external) return c.method.external_label != "dopri5" || c.param >= kTightestTolLongDopri5 * (1 - 1e-9);
+  if (c.method.external)
+    return c.method.spec.kind != nhi::Dopri5Method::name || c.param >= kTightestTolLongDopri5 * (1 - 1e-9);
   if (c.method.adaptive()) return false;  // the reference (CVODE): many times rkf78's cost per step here
   if (c.method.group == "costly") return false;
   const nhi::MethodTraits t = nhi::method_traits(sys, c.method.spec);
@@ -159,9 +160,12 @@ bool run(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<d
       obs(t, q, v);
     };
     try {
-      const long f = m.external_label == "rkf78"
-                         ? odeint_run<S, odeint::runge_kutta_fehlberg78<State<S>>>(sys, q0, v0, T, c.param, checked)
-                         : odeint_run<S, odeint::runge_kutta_dopri5<State<S>>>(sys, q0, v0, T, c.param, checked);
+      long f = 0;
+      nhi::with_method_type(m.spec.kind, [&](auto tag) {
+        using M = typename decltype(tag)::type;
+        if constexpr (nhi::is_embedded_rk<M>::value)
+          f = odeint_run<S, typename M::Pair::template stepper<State<S>>>(sys, q0, v0, T, c.param, checked);
+      });
       if (rhs) *rhs = f;
       return true;
     } catch (const Runaway&) {
@@ -214,74 +218,171 @@ Timing cpu_per_run(const S& sys, const Config& c, const Vec<double, S::n>& q0, c
   return timing_of(t);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const study::Options opt = study::parse(argc, argv, "Work-precision: CPU time against accuracy, every scene");
+// The configurations of every scene: the fixed-step "main" methods over h,
+// the reference solution and the external adaptive pairs over tolerances,
+// the costliest SPARK over its own h range.
+std::vector<Config> all_configs() {
   // Fixed-step "main" methods over h; the reference solution and the external
   // adaptive pairs over tolerances.
   const auto fixed =
       study::methods([](const nhi::StudyMethod& m) { return study::fixed_step(m) && m.group == "main"; });
-  const auto reference =
-      study::methods([](const nhi::StudyMethod& m) { return m.adaptive() && !m.external; });
+  const auto reference = study::methods([](const nhi::StudyMethod& m) { return m.adaptive() && !m.external; });
   const auto external = study::methods([](const nhi::StudyMethod& m) { return m.external; });
   const auto costly = study::methods([](const nhi::StudyMethod& m) {
     return study::fixed_step(m) && m.group == "costly" && m.spec.stages >= kCostlyMinStages;
   });
   // Every fixed-step method over the same h (see kFinestJ).
-  auto configs_for = [&](const auto&) {
-    std::vector<Config> configs;
-    for (int j = 0; j <= kFinestJ; ++j)
-      for (const auto& m : fixed) configs.push_back({m, 0.4 / (1 << j)});
-    for (int e = kLoosestTol; e <= kTightestTolReference; ++e)
-      for (const auto& m : reference) configs.push_back({m, std::pow(10.0, -e)});
-    for (int e = kLoosestTol; e <= kTightestTolPairs; ++e)
-      for (const auto& m : external) configs.push_back({m, std::pow(10.0, -e)});
-    for (int j = 0; j <= kFinestJCostly; ++j)
-      for (const auto& m : costly) configs.push_back({m, 0.4 / (1 << j)});
-    return configs;
-  };
-  json result = {{"study", "work_precision"},
-                 {"config",
-                  {{"T_final_error", kT_final},
-                   {"T_energy", kT_energy},
-                   {"T_energy_short", kT_energy_short},
-                   {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
-                   {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods), j = 0 ... " +
-                                   std::to_string(kFinestJCostly) + " (SPARK, stages >= " +
-                                   std::to_string(kCostlyMinStages) + ", no T_long run)"},
-                   {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
-                                      tol_range(kTightestTolPairs) + " (the explicit pairs)"},
-                   {"cpu",
-                    "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms, "
-                    "the median of 3 such timings (each cpu_* has its range [min, max] of the 3 in cpu_*_range); "
-                    "for fixed-step methods cpu_energy is cpu_energy_short times T_energy / T_energy_short (the same "
-                    "steps, 100 times as many); for the reference solution (CVODE, output every 0.1) the diagnosed run "
-                    "itself is the first of the 3 timings of cpu_energy when it took >= 0.5 s"},
-                   {"energy_error",
-                    "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output "
-                    "point every 0.1 (CVODE)"},
-                   {"energy_error_short", "the same over [0, T_energy_short]"},
-                   {"T_long", kT_long},
-                   {"long_scenes", kLongScenes},
-                   {"energy_error_long",
-                    "max |E - E0| over [0, T_long] (a separate run), on long_scenes only, for fixed steps h >= 0.1 (h "
-                    "= 0.4 for energy-preserving methods) and the explicit adaptive pairs at every tolerance (dopri5 "
-                    "down to 1e-10); cpu_energy_long is cpu_energy scaled by the ratio of steps (fixed-step) or of "
-                    "right-hand-side evaluations counted in the two runs (the adaptive pairs); status_long = failed "
-                    "(and no max_energy_error_long) when that run failed"},
-                   {"failed",
-                    "a run is stopped and failed (status = failed, not timed) at a step failure or where |E - E0| "
-                    "passes max(|E0|, 1): no target is met then, and a non-conservative method's energy, and with it "
-                    "an adaptive method's step count, can grow without bound"}}}};
+  std::vector<Config> configs;
+  for (int j = 0; j <= kFinestJ; ++j)
+    for (const auto& m : fixed) configs.push_back({m, 0.4 / (1 << j)});
+  for (int e = kLoosestTol; e <= kTightestTolReference; ++e)
+    for (const auto& m : reference) configs.push_back({m, std::pow(10.0, -e)});
+  for (int e = kLoosestTol; e <= kTightestTolPairs; ++e)
+    for (const auto& m : external) configs.push_back({m, std::pow(10.0, -e)});
+  for (int j = 0; j <= kFinestJCostly; ++j)
+    for (const auto& m : costly) configs.push_back({m, 0.4 / (1 << j)});
+  return configs;
+}
+
+// What the result's numbers mean.
+json study_config(){
+    return json{{"T_final_error", kT_final},
+                {"T_energy", kT_energy},
+                {"T_energy_short", kT_energy_short},
+                {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
+                {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods), j = 0 ... " +
+                                std::to_string(kFinestJCostly) +
+                                " (SPARK, stages >= " + std::to_string(kCostlyMinStages) + ", no T_long run)"},
+                {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
+                                   tol_range(kTightestTolPairs) + " (the explicit pairs)"},
+                {"cpu",
+                 "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms, "
+                 "the median of 3 such timings (each cpu_* has its range [min, max] of the 3 in cpu_*_range); "
+                 "for fixed-step methods cpu_energy is cpu_energy_short times T_energy / T_energy_short (the same "
+                 "steps, 100 times as many); for the reference solution (CVODE, output every 0.1) the diagnosed run "
+                 "itself is the first of the 3 timings of cpu_energy when it took >= 0.5 s"},
+                {"energy_error",
+                 "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output "
+                 "point every 0.1 (CVODE)"},
+                {"energy_error_short", "the same over [0, T_energy_short]"},
+                {"T_long", kT_long},
+                {"long_scenes", kLongScenes},
+                {"energy_error_long",
+                 "max |E - E0| over [0, T_long] (a separate run), on long_scenes only, for fixed steps h >= 0.1 (h "
+                 "= 0.4 for energy-preserving methods) and the explicit adaptive pairs at every tolerance (dopri5 "
+                 "down to 1e-10); cpu_energy_long is cpu_energy scaled by the ratio of steps (fixed-step) or of "
+                 "right-hand-side evaluations counted in the two runs (the adaptive pairs); status_long = failed "
+                 "(and no max_energy_error_long) when that run failed"},
+                {"failed",
+                 "a run is stopped and failed (status = failed, not timed) at a step failure or where |E - E0| "
+                 "passes max(|E0|, 1): no target is met then, and a non-conservative method's energy, and with it "
+                 "an adaptive method's step count, can grow without bound"}}};
+}
+
+// A finished run's timings (cpu_final, cpu_energy_short, cpu_energy, and
+// on the long scenes the T_long run's error and cost) into row.
+template <class S>
+void add_timings(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+                 double cpu_diagnosed, long rhs_energy, bool long_scene, json* out) {
+  constexpr int n = S::n;
+  json& row = *out;
+  const double E0 = nhi::energy(sys, q0, v0);
+  long rhs_long = 0;
+  put(out, "cpu_final", cpu_per_run(sys, c, q0, v0, kT_final));
+  const Timing cpu_short = cpu_per_run(sys, c, q0, v0, kT_energy_short);
+  put(out, "cpu_energy_short", cpu_short);
+  // A fixed-step run costs its number of steps times the cost of a step,
+  // so its T_energy cost is the T_energy_short cost scaled by the ratio of
+  // steps (measured, repeated to >= 50 ms); an adaptive run is timed whole.
+  // The reference solution's diagnosed run is its first timing when it
+  // took >= kSelfTimed: its observer sees one point per 0.1 time units
+  // (~1e5 energies, a few ms: under 1 % of such a run).
+  const bool self_timed = c.method.adaptive() && !c.method.external && cpu_diagnosed >= kSelfTimed;
+  const Timing cpu_energy = row["adaptive"].get<bool>()
+                                ? cpu_per_run(sys, c, q0, v0, kT_energy, self_timed ? cpu_diagnosed : -1)
+                                : cpu_short.scaled(kT_energy / kT_energy_short);
+  put(out, "cpu_energy", cpu_energy);
+  if (long_scene && long_run(sys, c)) {
+    double maxE_long = 0;
+    const bool ok3 = run(
+        sys, c, q0, v0, kT_long,
+        [&](double, const Vec<double, n>& q, const Vec<double, n>& v) {
+          maxE_long = std::max(maxE_long, std::abs(nhi::energy(sys, q, v) - E0));
+        },
+        true, &rhs_long);
+    if (ok3) {
+      // Scaled, not timed again: a fixed-step run by its steps, an
+      // external pair (the only adaptive methods run to T_long) by its
+      // right-hand-side evaluations, counted in the two runs; a timed
+      // rerun of the pairs to 10^6 would double the particle's cost.
+      put(out, "cpu_energy_long",
+          c.method.external ? cpu_energy.scaled(double(rhs_long) / double(rhs_energy))
+                            : cpu_short.scaled(kT_long / kT_energy_short));
+      row["max_energy_error_long"] = maxE_long;
+    } else {  // not ranked at T_long (summarize.sh needs max_energy_error_long)
+      row["status_long"] = "failed";
+      row["max_energy_error_long_before_failure"] = maxE_long;
+    }
+  }
+}
+
+// One configuration's row: its errors (final, energy over the horizons, at
+// the limit), then its timings where it ran to the end.
+template <class S>
+json run_row(const S& sys, const Config& c, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
+             const Vec<double, S::n>& qref, bool long_scene) {
+  constexpr int n = S::n;
+  const double E0 = nhi::energy(sys, q0, v0);
+  const bool adaptive = c.method.adaptive();
+  char param[32];
+  std::snprintf(param, sizeof param, "%g", c.param);
+  json row = {{"label", c.method.label()},
+              {"keys", c.method.spec.scene_keys() + (adaptive ? " tolerance=" : " h=") + param},
+              {"adaptive", adaptive},
+              {"param", c.param}};
+  Vec<double, n> qT = q0;
+  const bool ok1 = run(
+      sys, c, q0, v0, kT_final, [&](double, const Vec<double, n>& q, const Vec<double, n>&) { qT = q; }, true, nullptr,
+      true);
+  double maxE = 0, maxE_short = 0, t_end = 0;
+  Vec<double, n> q_end = q0, v_end = v0;
+  long rhs_energy = 0;  // right-hand sides of an external pair's runs
+  const double cpu0 = study::thread_cpu_seconds();
+  const bool ok2 = run(
+      sys, c, q0, v0, kT_energy,
+      [&](double t, const Vec<double, n>& q, const Vec<double, n>& v) {
+        maxE = std::max(maxE, std::abs(nhi::energy(sys, q, v) - E0));
+        if (t <= kT_energy_short * (1 + 1e-12)) maxE_short = maxE;
+        t_end = t;
+        q_end = q;
+        v_end = v;
+      },
+      true, &rhs_energy);
+  const double cpu_diagnosed = study::thread_cpu_seconds() - cpu0;
+  row["status"] = ok1 && ok2 ? "ok" : "failed";
+  row["final_error"] = (qT - qref).cwiseAbs().maxCoeff();
+  row["max_energy_error"] = maxE;
+  row["max_energy_error_short"] = maxE_short;
+  if (ok1 && ok2) study::add_limit_errors(sys, q0, v0, t_end, q_end, v_end, &row);
+  if (!(ok1 && ok2)) {  // not timed: it is never ranked (and might not end unguarded)
+    row["failure"] = "stopped at t = " + std::to_string(t_end) +
+                     ": step failure, or |E - E0| above max(|E0|, 1) (the energy ran away)";
+    return row;
+  }
+  add_timings(sys, c, q0, v0, cpu_diagnosed, rhs_energy, long_scene, &row);
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const study::Options opt = study::parse(argc, argv, "Work-precision: CPU time against accuracy, every scene");
+  const std::vector<Config> configs = all_configs();
+  json result = {{"study", "work_precision"}, {"config", study_config()}};
   for (const std::string& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
-      using S = std::decay_t<decltype(sys)>;
-      constexpr int n = S::n;
-      const Vec<double, n> qref = study::reference_q(sys, q0, v0, kT_final, 1e-13);
-      const double E0 = nhi::energy(sys, q0, v0);
-      const std::vector<Config> configs = configs_for(sys);
+      const auto qref = study::reference_q(sys, q0, v0, kT_final, 1e-13);
       const bool long_scene = std::find(kLongScenes.begin(), kLongScenes.end(), name) != kLongScenes.end();
       study::Cells cells;
       cells.label = "work-precision " + name;
@@ -297,82 +398,7 @@ int main(int argc, char** argv) {
         const double T = kT_final + kT_energy + (long_scene && long_run(sys, c) ? kT_long : 0.0);
         return c.method.adaptive() ? T * std::pow(c.param, -0.2) : T / c.param * study::step_weight(c.method.spec);
       };
-      cells.run = [&](size_t i) {
-        const Config& c = configs[i];
-        const bool adaptive = c.method.adaptive();
-        char param[32];
-        std::snprintf(param, sizeof param, "%g", c.param);
-        json row = {{"label", c.method.label()},
-                    {"keys", c.method.spec.scene_keys() + (adaptive ? " tolerance=" : " h=") + param},
-                    {"adaptive", adaptive},
-                    {"param", c.param}};
-        Vec<double, n> qT = q0;
-        const bool ok1 = run(
-            sys, c, q0, v0, kT_final, [&](double, const Vec<double, n>& q, const Vec<double, n>&) { qT = q; }, true,
-            nullptr, true);
-        double maxE = 0, maxE_short = 0, t_end = 0;
-        Vec<double, n> q_end = q0, v_end = v0;
-        long rhs_energy = 0, rhs_long = 0;  // right-hand sides of an external pair's runs
-        const double cpu0 = study::thread_cpu_seconds();
-        const bool ok2 = run(
-            sys, c, q0, v0, kT_energy,
-            [&](double t, const Vec<double, n>& q, const Vec<double, n>& v) {
-              maxE = std::max(maxE, std::abs(nhi::energy(sys, q, v) - E0));
-              if (t <= kT_energy_short * (1 + 1e-12)) maxE_short = maxE;
-              t_end = t;
-              q_end = q;
-              v_end = v;
-            },
-            true, &rhs_energy);
-        const double cpu_diagnosed = study::thread_cpu_seconds() - cpu0;
-        row["status"] = ok1 && ok2 ? "ok" : "failed";
-        row["final_error"] = (qT - qref).cwiseAbs().maxCoeff();
-        row["max_energy_error"] = maxE;
-        row["max_energy_error_short"] = maxE_short;
-        if (ok1 && ok2) study::add_limit_errors(sys, q0, v0, t_end, q_end, v_end, &row);
-        if (!(ok1 && ok2)) {  // not timed: it is never ranked (and might not end unguarded)
-          row["failure"] = "stopped at t = " + std::to_string(t_end) +
-                           ": step failure, or |E - E0| above max(|E0|, 1) (the energy ran away)";
-          return row;
-        }
-        put(&row, "cpu_final", cpu_per_run(sys, c, q0, v0, kT_final));
-        const Timing cpu_short = cpu_per_run(sys, c, q0, v0, kT_energy_short);
-        put(&row, "cpu_energy_short", cpu_short);
-        // A fixed-step run costs its number of steps times the cost of a step,
-        // so its T_energy cost is the T_energy_short cost scaled by the ratio of
-        // steps (measured, repeated to >= 50 ms); an adaptive run is timed whole.
-        // The reference solution's diagnosed run is its first timing when it
-        // took >= kSelfTimed: its observer sees one point per 0.1 time units
-        // (~1e5 energies, a few ms: under 1 % of such a run).
-        const bool self_timed = c.method.adaptive() && !c.method.external && cpu_diagnosed >= kSelfTimed;
-        const Timing cpu_energy = row["adaptive"].get<bool>()
-                                      ? cpu_per_run(sys, c, q0, v0, kT_energy, self_timed ? cpu_diagnosed : -1)
-                                      : cpu_short.scaled(kT_energy / kT_energy_short);
-        put(&row, "cpu_energy", cpu_energy);
-        if (long_scene && long_run(sys, c)) {
-          double maxE_long = 0;
-          const bool ok3 = run(
-              sys, c, q0, v0, kT_long,
-              [&](double, const Vec<double, n>& q, const Vec<double, n>& v) {
-                maxE_long = std::max(maxE_long, std::abs(nhi::energy(sys, q, v) - E0));
-              },
-              true, &rhs_long);
-          if (ok3) {
-            // Scaled, not timed again: a fixed-step run by its steps, an
-            // external pair (the only adaptive methods run to T_long) by its
-            // right-hand-side evaluations, counted in the two runs; a timed
-            // rerun of the pairs to 10^6 would double the particle's cost.
-            put(&row, "cpu_energy_long",
-                c.method.external ? cpu_energy.scaled(double(rhs_long) / double(rhs_energy))
-                                  : cpu_short.scaled(kT_long / kT_energy_short));
-            row["max_energy_error_long"] = maxE_long;
-          } else {  // not ranked at T_long (summarize.sh needs max_energy_error_long)
-            row["status_long"] = "failed";
-            row["max_energy_error_long_before_failure"] = maxE_long;
-          }
-        }
-        return row;
-      };
+      cells.run = [&](size_t i) { return run_row(sys, configs[i], q0, v0, qref, long_scene); };
       return json{{"scene", sc}, {"runs", study::map_cells(opt, cells)}};
     });
   }

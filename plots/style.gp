@@ -22,12 +22,13 @@ DOT = "(3,4)"
 DASHDOT = "(14,5,3,5)"
 LONG = "(30,8)"
 # One fixed style per method, everywhere, keyed by the method's label
-# (nhi::StudyMethod::label(), `nhi list`): method_ls(label) is its line style.
+# (nhi::StudyMethod::label(), `nhi list`): method_ls(label) is its line style,
+# the number its study entry declares (plots/method_styles.gp).
 # Styles are numbered by family (reference 10, DLA 11-19, mp06 21-24, discrete
 # gradient 31-38, SPARK 41-43, RK4 51, adaptive 61-62, the convergence study's
 # isolation runs 71-78), so that sorting by style (SORT_BY_STY) groups a legend
-# by family with the reference first.  A new method gets a line of its own in
-# its family's range; a label not listed is drawn in grey (line style 99).
+# by family with the reference first.  A new method declares a number in its
+# family's range; a label without one is drawn in grey (line style 99).
 set style line 10 lc rgb "#000000" lw 2.0 dt 1 pt 7  ps 0.6
 set style line 11 lc rgb "#0072B2" lw 1.5 dt 1 pt 7  ps 0.8
 set style line 12 lc rgb "#0072B2" lw 1.5 dt @DASH pt 9  ps 0.9
@@ -66,35 +67,9 @@ set style line 76 lc rgb "#0072B2" lw 1.5 dt @DASH pt 8  ps 0.9
 set style line 77 lc rgb "#0072B2" lw 1.5 dt @DASHDOT pt 12 ps 0.9
 set style line 78 lc rgb "#0072B2" lw 1.5 dt @DOT pt 4  ps 0.8
 set style line 99 lc rgb "#999999" lw 1.0 dt 1 pt 6  ps 0.8
-method_ls(label) = \
-  label eq "reference" ? 10 : \
-  label eq "dla a=0.5" ? 11 : \
-  label eq "dla a=0.5+triple_jump" ? 12 : \
-  label eq "dla-sym a=0" ? 13 : \
-  label eq "dla-sym a=0+triple_jump" ? 14 : \
-  label eq "dla a=0" ? 15 : \
-  label eq "dla a=0.25" ? 16 : \
-  label eq "dla a=0.75" ? 17 : \
-  label eq "dla a=1" ? 18 : \
-  label eq "dla-sym a=0.25" ? 19 : \
-  label eq "mp06" ? 21 : \
-  label eq "mp06+triple_jump" ? 22 : \
-  label eq "mp06+suzuki5" ? 23 : \
-  label eq "mp06+order6" ? 24 : \
-  label eq "discrete_gradient" ? 31 : \
-  label eq "discrete_gradient+triple_jump" ? 32 : \
-  label eq "discrete_gradient+suzuki5" ? 33 : \
-  label eq "discrete_gradient+order6" ? 34 : \
-  label eq "discrete_gradient endpoint" ? 35 : \
-  label eq "discrete_gradient endpoint+triple_jump" ? 36 : \
-  label eq "discrete_gradient endpoint+suzuki5" ? 37 : \
-  label eq "discrete_gradient endpoint+order6" ? 38 : \
-  label eq "spark s=2" ? 41 : \
-  label eq "spark s=3" ? 42 : \
-  label eq "spark s=4" ? 43 : \
-  label eq "rk4" ? 51 : \
-  label eq "rkf78" ? 61 : \
-  label eq "dopri5" ? 62 : \
+# The methods' styles by label (method_ls), written from their declarations by
+# `nhi list --gnuplot`; other_ls: the convergence study's isolation runs, else grey.
+other_ls(label) = \
   label eq "L_d^a + omega_d^1/2, p0 = dL/dv (a=0)" ? 71 : \
   label eq "L_d^a + omega_d^1/2, consistent p0 (a=0)" ? 72 : \
   label eq "L_d^1/2 + omega_d^a, p0 = dL/dv (a=0)" ? 73 : \
@@ -104,6 +79,7 @@ method_ls(label) = \
   label eq "L_d^1/2 + omega_d^a, p0 = dL/dv (a=0.25)" ? 77 : \
   label eq "L_d^a + omega_d^a, consistent p0 (a=0.25)" ? 78 : \
   99
+load "plots/method_styles.gp"
 # `eval SORT_BY_STY` after a script has set N and STY[1..N] (method_ls of each
 # method): ORD[1..N] lists the methods' indices (1-based) by style, i.e. by
 # family with the reference first.  Plot `for [k=1:N]` with ORD[k] to draw the

@@ -208,8 +208,9 @@ PYBIND11_MODULE(nhi, mod) {
       "The registered systems: name, n, m, params (name: default), q0, v0, reversible, separable.");
   mod.def(
       "methods", [] { return to_python(nhi::catalog()["methods"]); },
-      "Every method the studies run: label, keys (the scene keys that select it), method, discretization, alpha,\n"
-      "stages, constraint, composition, order, symmetric, implicit, adaptive, composable, group.");
+      "Every method the studies run: label, keys (the scene keys that select it), method, composition, order,\n"
+      "symmetric, implicit, adaptive, composable, group, style, own (the method's own scene keys, declared by\n"
+      "the method) and every method's key (discretization, alpha, stages, constraint, ...: null where not its own).");
   mod.def(
       "compositions", [] { return to_python(nhi::catalog()["compositions"]); },
       "The compositions of a symmetric method: name, order, stages.");

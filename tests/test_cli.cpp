@@ -299,6 +299,20 @@ TEST_F(Cli, ListNamesEverySystemMethodAndComposition) {
   EXPECT_EQ(run("list --markdown --json").code, 2);
 }
 
+// plots/method_styles.gp is what `nhi list --gnuplot` writes from the methods'
+// declared line styles (make figures rewrites it): a method added or restyled
+// without it fails here, with the file's new text.
+TEST_F(Cli, MethodStylesFileIsTheMethodsDeclaredStyles) {
+  const std::string out = path("method_styles.gp");
+  ASSERT_EQ(run("list --gnuplot > " + out).code, 0);
+  std::stringstream now, committed;
+  now << std::ifstream(out).rdbuf();
+  committed << std::ifstream(NHI_SOURCE_DIR "/plots/method_styles.gp").rdbuf();
+  EXPECT_EQ(committed.str(), now.str()) << "plots/method_styles.gp is stale: run `build/bin/nhi list --gnuplot > "
+                                           "plots/method_styles.gp` (or make figures)";
+  EXPECT_NE(now.str().find("label eq \"dla a=0.5\" ? 11 :"), std::string::npos) << now.str();
+}
+
 TEST_F(Cli, BadCommandLinesFailWithOneLine) {
   const std::string out = path("out.json");
   std::ofstream(out) << "precious";

@@ -66,6 +66,18 @@ inline const Composition& composition(const std::string& name) {
   throw std::invalid_argument("unknown composition \"" + name + "\"");
 }
 
+// The one stage loop's bookkeeping, for Composed and ComposedDla
+// (dla_composition.hpp): stage i's summary s into the step's total; a failed
+// stage fails the step, its message naming the stage.  Returns s.ok().
+inline bool add_stage(const Composition& c, size_t i, const StepSummary& s, StepSummary* total) {
+  total->add_stage(s);
+  if (s.ok()) return true;
+  total->status = SolveStatus::kFailed;
+  total->failure = s.failure;
+  total->message = c.name + " stage " + std::to_string(i + 1) + " of " + std::to_string(c.gamma.size()) + ": " + s.message;
+  return false;
+}
+
 // Does the inner stepper start each step from its multiplier alone
 // (Inner::starts_from_multiplier, with lambda() and guess_lambda())?
 template <class Inner, class = void>
@@ -149,20 +161,7 @@ class Composed {
         if (remember && !s.ok()) retry(c_.gamma[i] * h, stage_lambda_[i == 0 ? c_.gamma.size() - 1 : i - 1], &s);
         stage_lambda_[i] = inner_.lambda();
       }
-      total.iterations += s.iterations;
-      total.evaluations += s.evaluations;
-      total.jacobians += s.jacobians;
-      total.rhs_evaluations += s.rhs_evaluations;
-      total.used_fallback = total.used_fallback || s.used_fallback;
-      total.merge_root(s.root);
-      total.relative_residual = std::max(total.relative_residual, s.relative_residual);
-      if (!s.ok()) {
-        total.status = SolveStatus::kFailed;
-        total.failure = s.failure;
-        total.message =
-            c_.name + " stage " + std::to_string(i + 1) + " of " + std::to_string(c_.gamma.size()) + ": " + s.message;
-        return total;
-      }
+      if (!add_stage(c_, i, s, &total)) return total;
     }
     total.status = SolveStatus::kConverged;
     if constexpr (kStageMemory) h_last_ = h;
@@ -186,10 +185,7 @@ class Composed {
   [[gnu::noinline, gnu::cold]] void retry(double h, const Vec<double, m>& previous, StepSummary* s) {
     inner_.guess_lambda(previous);
     StepSummary again = inner_.step(h);
-    again.iterations += s->iterations;
-    again.evaluations += s->evaluations;
-    again.jacobians += s->jacobians;
-    again.rhs_evaluations += s->rhs_evaluations;
+    again.add_cost(*s);
     *s = std::move(again);
   }
 

@@ -15,6 +15,10 @@
 
 namespace nhi {
 
+// The default tolerance of every method that has one (the implicit methods'
+// relative residual, the adaptive methods' rtol = atol): the scene's default.
+inline constexpr double kDefaultTolerance = 1e-12;
+
 template <class T, int N>
 using Vec = Eigen::Matrix<T, N, 1>;
 template <class T, int R, int C>

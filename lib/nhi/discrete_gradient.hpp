@@ -50,6 +50,7 @@
 #include "nhi/composition.hpp"
 #include "nhi/hamiltonian.hpp"
 #include "nhi/method_spec.hpp"
+#include "nhi/spec_options.hpp"
 #include "nhi/solver.hpp"
 
 namespace nhi {
@@ -379,14 +380,14 @@ struct DiscreteGradientMethod {
       s.composition = c;
       return s;
     };
-    return {{spec_of(name)},
-            {spec_of(name, "triple_jump")},
-            {spec_of(name, "suzuki5"), "variant"},
-            {spec_of(name, "order6"), "variant"},
-            {e, "costly"},
-            {composed("triple_jump"), "costly"},
-            {composed("suzuki5"), "costly"},
-            {composed("order6"), "costly"}};
+    return {{spec_of(name), "main", 31},
+            {spec_of(name, "triple_jump"), "main", 32},
+            {spec_of(name, "suzuki5"), "variant", 33},
+            {spec_of(name, "order6"), "variant", 34},
+            {e, "costly", 35},
+            {composed("triple_jump"), "costly", 36},
+            {composed("suzuki5"), "costly", 37},
+            {composed("order6"), "costly", 38}};
   }
 };
 

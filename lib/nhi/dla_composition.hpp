@@ -55,20 +55,7 @@ class ComposedDla {
   StepSummary step(double h) {
     StepSummary total;
     for (size_t i = 0; i < c_.gamma.size(); ++i) {
-      StepSummary s = dla_.step(c_.gamma[i] * h);
-      total.iterations += s.iterations;
-      total.evaluations += s.evaluations;
-      total.jacobians += s.jacobians;
-      total.used_fallback = total.used_fallback || s.used_fallback;
-      total.merge_root(s.root);
-      total.relative_residual = std::max(total.relative_residual, s.relative_residual);
-      if (!s.ok()) {
-        total.status = SolveStatus::kFailed;
-        total.failure = s.failure;
-        total.message =
-            c_.name + " stage " + std::to_string(i + 1) + " of " + std::to_string(c_.gamma.size()) + ": " + s.message;
-        return total;
-      }
+      if (!add_stage(c_, i, dla_.step(c_.gamma[i] * h), &total)) return total;
     }
     ++steps_;
     total.status = SolveStatus::kConverged;

@@ -37,12 +37,14 @@ namespace nhi {
 struct Rkf78Pair {
   static constexpr const char* name = "rkf78";
   static constexpr int order = 8;
+  static constexpr int style = 61;  // its line style in the figures (StudyEntry)
   template <class State>
   using stepper = boost::numeric::odeint::runge_kutta_fehlberg78<State>;
 };
 struct Dopri5Pair {
   static constexpr const char* name = "dopri5";
   static constexpr int order = 5;
+  static constexpr int style = 62;
   template <class State>
   using stepper = boost::numeric::odeint::runge_kutta_dopri5<State>;
 };
@@ -70,7 +72,7 @@ struct OdeRhs {
 };
 
 struct EmbeddedRkOptions {
-  double atol = 1e-12, rtol = 1e-12;
+  double atol = kDefaultTolerance, rtol = kDefaultTolerance;
   double first_step = 0.01;     // the first trial step (the work-precision study's)
   long max_steps = 100000000L;  // accepted steps per output interval
 };

@@ -38,6 +38,7 @@
 #include "nhi/rk4.hpp"
 #include "nhi/run.hpp"
 #include "nhi/spark.hpp"
+#include "nhi/spec_options.hpp"
 #include "nhi/typelist.hpp"
 
 namespace nhi {
@@ -86,21 +87,21 @@ struct DlaMethod {
     return f(st);
   }
   static std::vector<StudyEntry> study_entries() {
-    auto dla = [](const char* disc, double alpha, const char* group) {
+    auto dla = [](const char* disc, double alpha, const char* group, int style) {
       MethodSpec s;
       s.discretization = disc;
       s.alpha = alpha;
-      return StudyEntry{s, group};
+      return StudyEntry{s, group, style};
     };
-    StudyEntry tj = dla("alpha", 0.5, "main"), tj_sym = dla("symmetric", 0.0, "variant");
+    StudyEntry tj = dla("alpha", 0.5, "main", 12), tj_sym = dla("symmetric", 0.0, "variant", 14);
     tj.spec.composition = tj_sym.spec.composition = "triple_jump";
-    return {dla("alpha", 0.5, "main"),
-            dla("symmetric", 0.0, "main"),
-            dla("alpha", 0.0, "variant"),
-            dla("alpha", 0.25, "variant"),
-            dla("alpha", 0.75, "variant"),
-            dla("alpha", 1.0, "variant"),
-            dla("symmetric", 0.25, "variant"),
+    return {dla("alpha", 0.5, "main", 11),
+            dla("symmetric", 0.0, "main", 13),
+            dla("alpha", 0.0, "variant", 15),
+            dla("alpha", 0.25, "variant", 16),
+            dla("alpha", 0.75, "variant", 17),
+            dla("alpha", 1.0, "variant", 18),
+            dla("symmetric", 0.25, "variant", 19),
             tj,
             tj_sym};
   }
@@ -119,7 +120,7 @@ struct Rk4Method {
     Rk4Stepper<S> st(sys);
     return f(st);
   }
-  static std::vector<StudyEntry> study_entries() { return {{spec_of(name)}}; }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", 51}}; }
 };
 
 // The reference solution (scene value "benchmark", kept for the runner's contract).
@@ -138,14 +139,15 @@ struct ReferenceMethod {
     ReferenceStepper<S> st(sys, opt);
     return f(st);
   }
-  static std::vector<StudyEntry> study_entries() { return {{spec_of(name)}}; }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", 10}}; }
 };
 
 // The adaptive explicit pairs rkf78 and dopri5 (embedded_rk.hpp): the
 // scene's tolerance is atol = rtol, h the output interval.  Only the
 // work-precision study runs them (study_methods() lists them there).
-template <class Pair>
+template <class P>
 struct EmbeddedRkMethod {
+  using Pair = P;
   static constexpr const char* name = Pair::name;
   static constexpr bool adaptive = true;
   static std::vector<MethodKey> keys() { return {}; }
@@ -160,8 +162,12 @@ struct EmbeddedRkMethod {
     EmbeddedRkStepper<S, Pair> st(sys, opt);
     return f(st);
   }
-  static std::vector<StudyEntry> study_entries() { return {}; }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", Pair::style, true}}; }
 };
+template <class M>
+struct is_embedded_rk : std::false_type {};
+template <class P>
+struct is_embedded_rk<EmbeddedRkMethod<P>> : std::true_type {};
 using Rkf78Method = EmbeddedRkMethod<Rkf78Pair>;
 using Dopri5Method = EmbeddedRkMethod<Dopri5Pair>;
 
@@ -264,8 +270,8 @@ struct StudyMethod {
   MethodSpec spec;
   std::string group;  // "main", "variant" or "costly"
   bool external = false;  // the work-precision study's adaptive pairs
-  std::string external_label;
-  std::string label() const { return external ? external_label : spec.label(); }
+  int style = 99;         // its line style in the figures (StudyEntry)
+  std::string label() const { return spec.label(); }
   // An adaptive method (the reference, the pairs): h is its output interval.
   bool adaptive() const { return method_flags(spec.kind).adaptive; }
   // A method with a fixed step (not the adaptive reference, not the pairs).
@@ -275,13 +281,12 @@ struct StudyMethod {
 inline const std::vector<StudyMethod>& study_methods() {
   static const std::vector<StudyMethod> list = [] {
     std::vector<StudyMethod> out;
-    for (const char* group : {"main", "variant", "costly"})
-      for_each_type(Methods{}, [&](auto tag) {
-        for (const StudyEntry& e : decltype(tag)::type::study_entries())
-          if (e.group == group) out.push_back({e.spec, e.group, false, ""});
-      });
-    out.push_back({spec_of(Rkf78Method::name), "main", true, Rkf78Method::name});
-    out.push_back({spec_of(Dopri5Method::name), "main", true, Dopri5Method::name});
+    for (const bool external : {false, true})
+      for (const char* group : {"main", "variant", "costly"})
+        for_each_type(Methods{}, [&](auto tag) {
+          for (const StudyEntry& e : decltype(tag)::type::study_entries())
+            if (e.group == group && e.external == external) out.push_back({e.spec, e.group, e.external, e.style});
+        });
     return out;
   }();
   return list;

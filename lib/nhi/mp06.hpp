@@ -31,6 +31,7 @@
 #include "nhi/composition.hpp"
 #include "nhi/hamiltonian.hpp"
 #include "nhi/method_spec.hpp"
+#include "nhi/spec_options.hpp"
 #include "nhi/solver.hpp"
 
 namespace nhi {
@@ -464,7 +465,10 @@ struct Mp06Method {
     return with_composition(Mp06Stepper<S>(sys, opt), spec.composition, f);
   }
   static std::vector<StudyEntry> study_entries() {
-    return {{spec_of(name)}, {spec_of(name, "triple_jump")}, {spec_of(name, "suzuki5")}, {spec_of(name, "order6")}};
+    return {{spec_of(name), "main", 21},
+            {spec_of(name, "triple_jump"), "main", 22},
+            {spec_of(name, "suzuki5"), "main", 23},
+            {spec_of(name, "order6"), "main", 24}};
   }
 };
 

@@ -86,15 +86,7 @@ StepSummary Mp06Stepper<S, kSeparableForm>::step(double h) {
   VecM lambda = lambda_;
   StepSummary s = map(h, q_, p_, &q1, &p1, &lambda);
   ++steps_;
-  if (s.ok() && !(all_finite(q1) && all_finite(p1))) {
-    s.status = SolveStatus::kFailed;
-    s.failure = FailureKind::kNonFinite;
-    s.message = "non-finite state";
-  }
-  if (!s.ok()) {
-    s.message = "mp06 step " + std::to_string(steps_) + " did not converge: " + s.message;
-    return s;
-  }
+  if (step_failed(&s, all_finite(q1) && all_finite(p1), "mp06 step ", steps_)) return s;
   q_ = q1;
   p_ = p1;
   lambda_ = lambda;

@@ -25,8 +25,8 @@
 namespace nhi {
 
 struct ReferenceOptions {
-  double rtol = 1e-12;
-  double atol = 1e-12;
+  double rtol = kDefaultTolerance;
+  double atol = kDefaultTolerance;
   long max_steps = 2000000000L;  // per output interval (CVODE's default is 500)
 };
 

@@ -68,7 +68,6 @@
 #include <type_traits>
 #include <utility>
 
-#include "nhi/method_spec.hpp"
 #include "nhi/stepper.hpp"
 
 namespace nhi {
@@ -100,7 +99,7 @@ struct has_rounding_terms<P, std::void_t<decltype(std::declval<const P&>().round
                                  std::declval<Vec<double, P::ny + P::nl>*>()))>> : std::true_type {};
 
 struct SolverOptions {
-  double tolerance = 1e-12;  // required relative residual
+  double tolerance = kDefaultTolerance;  // required relative residual
   int max_iterations = 20;   // Newton iterations before the fallback
   bool fallback = true;      // retry a failed Newton with ceres::TinySolver
   // Keep the factorization (a chord step) while each iteration shrinks the
@@ -114,15 +113,6 @@ struct SolverOptions {
   double continuation_dh = 0.05;  // largest sub-step of the continuation in h
   bool follows_roots() const { return continuation || root_check; }
 };
-
-// The solver options a MethodSpec asks for (tolerance, root following).
-inline SolverOptions solver_options(const MethodSpec& spec) {
-  SolverOptions opt;
-  opt.tolerance = spec.tolerance;
-  opt.continuation = spec.start == "continuation";
-  opt.root_check = spec.root_check && !opt.continuation;
-  return opt;
-}
 
 template <class P>
 class NewtonSolver {

@@ -34,6 +34,7 @@
 #include "nhi/composition.hpp"
 #include "nhi/hamiltonian.hpp"
 #include "nhi/method_spec.hpp"
+#include "nhi/spec_options.hpp"
 #include "nhi/mp06.hpp"
 #include "nhi/solver.hpp"
 
@@ -367,7 +368,7 @@ struct SparkMethod {
     auto spark = [](int st, const char* group) {
       MethodSpec sp = spec_of(name);
       sp.stages = st;
-      return StudyEntry{sp, group};
+      return StudyEntry{sp, group, 39 + st};  // line styles 41-43
     };
     // Newton on all 2ns + ms unknowns at once costs 25-1040 RK4 steps a step
     // (results/step_costs.json): the short-run studies only (methods.hpp).

@@ -39,15 +39,7 @@ StepSummary SparkStepper<S, s>::step(double h) {
   VecML lambda = lambda_;
   StepSummary st = map(h, q_, p_, &q1, &p1, &lambda);
   ++steps_;
-  if (st.ok() && !(all_finite(q1) && all_finite(p1))) {
-    st.status = SolveStatus::kFailed;
-    st.failure = FailureKind::kNonFinite;
-    st.message = "non-finite state";
-  }
-  if (!st.ok()) {
-    st.message = "spark step " + std::to_string(steps_) + " did not converge: " + st.message;
-    return st;
-  }
+  if (step_failed(&st, all_finite(q1) && all_finite(p1), "spark step ", steps_)) return st;
   q_ = q1;
   p_ = p1;
   lambda_ = lambda;

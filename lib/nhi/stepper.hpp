@@ -93,7 +93,44 @@ struct StepSummary {
   // Merge the root check of another solve of the same step (a stage, a retry).
   void merge_root(RootCheck r) { root = std::max(root, r); }
   bool ok() const { return status == SolveStatus::kConverged; }
+  // The one way to count a step's cost: add another solve's counts (a
+  // retry's, a fallback's, a predictor's) to this summary's.
+  void add_cost(const StepSummary& s) {
+    iterations += s.iterations;
+    evaluations += s.evaluations;
+    jacobians += s.jacobians;
+    rhs_evaluations += s.rhs_evaluations;
+    internal_steps += s.internal_steps;
+    rejected_steps += s.rejected_steps;
+  }
+  // A stage of this step (a composition's): its counts, its fallback, its
+  // root check and the largest residual.
+  void add_stage(const StepSummary& s) {
+    add_cost(s);
+    used_fallback = used_fallback || s.used_fallback;
+    merge_root(s.root);
+    relative_residual = std::max(relative_residual, s.relative_residual);
+  }
 };
+
+// The one failed-step wrapper, at the end of every implicit step: a step
+// whose solve converged to a non-finite state fails as kNonFinite; a failed
+// step's message names the step (what + k: "mp06 step 7") and says which
+// failure it was: "... did not converge: <the solver's reason>" or "...:
+// non-finite state (the solve converged)".  Returns whether the step failed
+// (the message is built only then).
+inline bool step_failed(StepSummary* s, bool state_finite, const char* what, long k) {
+  if (s->ok() && state_finite) return false;
+  const std::string step = what + std::to_string(k);
+  if (s->ok()) {
+    s->status = SolveStatus::kFailed;
+    s->failure = FailureKind::kNonFinite;
+    s->message = step + ": non-finite state (the solve converged)";
+  } else {
+    s->message = step + " did not converge: " + s->message;
+  }
+  return true;
+}
 
 // What a method declares about itself; tests and studies read these instead of
 // hard-coding expectations.

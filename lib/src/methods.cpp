@@ -21,12 +21,11 @@ std::string MethodSpec::scene_keys() const {
   bool known = false;
   for_each_type(Methods{}, [&](auto tag) { known = known || kind == decltype(tag)::type::name; });
   for (const MethodKey& k : known ? method_flags(kind).keys : std::vector<MethodKey>{}) {
-    if (k.text && this->*k.text != defaults.*k.text) out += std::string(" ") + k.name + "=" + this->*k.text;
-    if (k.whole && this->*k.whole != defaults.*k.whole)
-      out += std::string(" ") + k.name + "=" + std::to_string(this->*k.whole);
-    if (k.number && this->*k.number != defaults.*k.number) {
+    if (k.kind == MethodKey::Kind::kChoice) {
+      if (k.text_of(*this) != k.text_of(defaults)) out += std::string(" ") + k.name + "=" + k.text_of(*this);
+    } else if (k.number_of(*this) != k.number_of(defaults)) {
       char buf[32];
-      std::snprintf(buf, sizeof buf, "=%g", this->*k.number);
+      std::snprintf(buf, sizeof buf, "=%g", k.number_of(*this));
       out += std::string(" ") + k.name + buf;
     }
   }

@@ -31,9 +31,8 @@ auto with_method_run(const MethodSpec& spec, F&& f) {
 template <class S>
 RunReport run_spec(const S& sys, const MethodSpec& spec, const Vec<double, S::n>& q0, const Vec<double, S::n>& v0,
                    double h, long steps, const SampleObserver<S::n, S::m>& observe, const EnergyLimit& limit) {
-  return with_method_run<S>(spec, [&](auto run) {
-    return decltype(run)::type::run(sys, spec, q0, v0, h, steps, observe, limit);
-  });
+  return with_method_run<S>(
+      spec, [&](auto run) { return decltype(run)::type::run(sys, spec, q0, v0, h, steps, observe, limit); });
 }
 
 template <class S>
@@ -48,13 +47,11 @@ std::unique_ptr<AnyStepper<S::n, S::m>> make_stepper(const S& sys, const MethodS
 
 }  // namespace nhi
 
-#define NHI_RUN_INSTANCES_(S)                                                                                       \
-  template nhi::RunReport nhi::run_spec<nhi::S>(const nhi::S&, const nhi::MethodSpec&,                              \
-                                                const nhi::Vec<double, nhi::S::n>&,                                 \
-                                                const nhi::Vec<double, nhi::S::n>&, double, long,                   \
-                                                const nhi::SampleObserver<nhi::S::n, nhi::S::m>&,                   \
-                                                const nhi::EnergyLimit&);                                           \
-  template nhi::MethodTraits nhi::method_traits<nhi::S>(const nhi::S&, const nhi::MethodSpec&);                     \
-  template std::unique_ptr<nhi::AnyStepper<nhi::S::n, nhi::S::m>> nhi::make_stepper<nhi::S>(const nhi::S&,          \
-                                                                                          const nhi::MethodSpec&);
+#define NHI_RUN_INSTANCES_(S)                                                                                        \
+  template nhi::RunReport nhi::run_spec<nhi::S>(                                                                     \
+      const nhi::S&, const nhi::MethodSpec&, const nhi::Vec<double, nhi::S::n>&, const nhi::Vec<double, nhi::S::n>&, \
+      double, long, const nhi::SampleObserver<nhi::S::n, nhi::S::m>&, const nhi::EnergyLimit&);                      \
+  template nhi::MethodTraits nhi::method_traits<nhi::S>(const nhi::S&, const nhi::MethodSpec&);                      \
+  template std::unique_ptr<nhi::AnyStepper<nhi::S::n, nhi::S::m>> nhi::make_stepper<nhi::S>(const nhi::S&,           \
+                                                                                            const nhi::MethodSpec&);
 NHI_REGISTERED_SYSTEMS(NHI_RUN_INSTANCES_)

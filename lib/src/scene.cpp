@@ -38,9 +38,11 @@ const std::vector<std::string>& scene_keys() {
 json method_key_value(const MethodKey& k, const json& scene) {
   const MethodSpec defaults;
   const bool given = scene.contains(k.name);
-  if (k.text) return given ? json(one_of(scene[k.name], k.name, k.choices)) : json(defaults.*k.text);
-  if (k.whole) return given ? integer(scene[k.name], k.name, long(k.lo), long(k.hi)) : long(defaults.*k.whole);
-  if (!given) return defaults.*k.number;
+  if (k.kind == MethodKey::Kind::kChoice)
+    return given ? json(one_of(scene[k.name], k.name, k.choices)) : json(k.text_of(defaults));
+  if (k.kind == MethodKey::Kind::kInteger)
+    return given ? integer(scene[k.name], k.name, long(k.lo), long(k.hi)) : long(k.number_of(defaults));
+  if (!given) return k.number_of(defaults);
   const double x = finite_number(scene[k.name], k.name);
   if (!(x >= k.lo && x <= k.hi)) {
     char range[64];
@@ -53,9 +55,10 @@ json method_key_value(const MethodKey& k, const json& scene) {
 // The method keys' values of a resolved scene, into spec.
 void set_method_keys(MethodSpec* spec, const json& resolved) {
   for (const MethodKey& k : all_method_keys()) {
-    if (k.text) spec->*k.text = resolved[k.name].get<std::string>();
-    if (k.whole) spec->*k.whole = static_cast<int>(resolved[k.name].get<long>());
-    if (k.number) spec->*k.number = resolved[k.name].get<double>();
+    if (k.kind == MethodKey::Kind::kChoice)
+      k.set_text(spec, resolved[k.name].get<std::string>());
+    else
+      k.set_number(spec, resolved[k.name].get<double>());
   }
 }
 
@@ -221,16 +224,17 @@ json catalog() {
                   {"implicit", t.implicit},
                   {"adaptive", t.adaptive},
                   {"composable", m.spec.composition == "none" && method_is_symmetric(m.spec)},
-                  {"group", m.group}};
+                  {"group", m.group},
+                  {"style", m.style}};
     // Every method key: its value where the method has it, else null; "own"
     // lists the method's keys in their declared order.
     for (const MethodKey& k : all_method_keys()) entry[k.name] = nullptr;
     entry["own"] = json::array();
     for (const MethodKey& k : method_flags(m.spec.kind).keys) {
       entry["own"].push_back(k.name);
-      if (k.text) entry[k.name] = m.spec.*k.text;
-      if (k.whole) entry[k.name] = m.spec.*k.whole;
-      if (k.number) entry[k.name] = m.spec.*k.number;
+      if (k.kind == MethodKey::Kind::kChoice) entry[k.name] = k.text_of(m.spec);
+      if (k.kind == MethodKey::Kind::kInteger) entry[k.name] = long(k.number_of(m.spec));
+      if (k.kind == MethodKey::Kind::kNumber) entry[k.name] = k.number_of(m.spec);
     }
     out["methods"].push_back(entry);
   }

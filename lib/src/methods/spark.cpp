@@ -1,8 +1,8 @@
 // SPARK (spark.hpp), its steppers and runner glue, compiled
 // for every registered system: this method's translation unit (run.hpp).
 #include "nhi/methods.hpp"
-#include "nhi/spark_body.hpp"
 #include "nhi/run_body.hpp"
+#include "nhi/spark_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off
