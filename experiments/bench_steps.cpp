@@ -196,6 +196,14 @@ void BM_Mp06NrFloor(benchmark::State& state) {
   state.counters["newton_iterations_per_step"] = double(hand.iterations) / double(state.iterations());
 }
 
+// A method row's benchmark name (scene/label, spaces as '_': Google
+// Benchmark's filters split on them) and the method's label and scene keys,
+// which each row also carries.
+std::map<std::string, std::pair<std::string, std::string>>& method_rows() {
+  static std::map<std::string, std::pair<std::string, std::string>> rows;
+  return rows;
+}
+
 class Capture : public benchmark::ConsoleReporter {
  public:
   nhi::json rows = nhi::json::array();
@@ -212,6 +220,8 @@ class Capture : public benchmark::ConsoleReporter {
                        {"real_ns", r.GetAdjustedRealTime()},
                        {"cpu_ns", r.GetAdjustedCPUTime()}};
       for (const auto& [k, c] : r.counters) row["counters"][k] = double(c);
+      const auto method = method_rows().find(r.benchmark_name());
+      if (method != method_rows().end()) row["label"] = method->second.first, row["keys"] = method->second.second;
       rows.push_back(row);
     }
     ConsoleReporter::ReportRuns(runs);
@@ -243,6 +253,7 @@ void register_all(int shard, int nshards) {
       if (!m.fixed_step()) continue;  // every fixed-step method, variants too
       std::string name = scene + "/" + m.label();
       std::replace(name.begin(), name.end(), ' ', '_');
+      method_rows()[name] = {m.label(), m.spec.scene_keys()};
       const nhi::MethodSpec spec = m.spec;
       benchmark::RegisterBenchmark(name.c_str(), [spec](benchmark::State& st) { BM_Method<S>(st, spec); });
     }

@@ -19,11 +19,16 @@
 #pragma once
 
 #include <Eigen/LU>
+#include <cstdio>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "nhi/composition.hpp"
 #include "nhi/dla.hpp"
 #include "nhi/hamiltonian.hpp"
+#include "nhi/method_spec.hpp"
+#include "nhi/spec_options.hpp"
 
 namespace nhi {
 
@@ -103,6 +108,71 @@ class ComposedDla {
   Composition c_;
   VecN v0_ = VecN::Zero();
   long steps_ = 0;
+};
+
+// The method table's entry (methods.hpp): "dla", the paper's method.
+struct DlaMethod {
+  static constexpr const char* name = "dla";
+  static constexpr bool adaptive = false;
+  // The paper's discretizations: L_d^alpha, omega_d^alpha (eqs. 9, 13) or the
+  // symmetric L_d^{sym,alpha}, omega_d^{sym,alpha} (eqs. 10, 14); alpha in [0, 1].
+  static std::vector<MethodKey> keys() {
+    return {MethodKey::choice("discretization", &MethodSpec::discretization, {"alpha", "symmetric"}),
+            MethodKey::range("alpha", &MethodSpec::alpha, 0.0, 1.0)};
+  }
+  static constexpr bool reports_p = true;
+  static constexpr double step_cost = 6.0;
+  static std::string label(const MethodSpec& spec) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s a=%g", spec.discretization == "alpha" ? "dla" : "dla-sym", spec.alpha);
+    return buf;
+  }
+  // Self-adjoint discretizations (alpha = 1/2, the symmetric family) compose:
+  // dla_composition.hpp, README "Methods".
+  static bool symmetric(const MethodSpec& spec) {
+    return spec.discretization == "symmetric" || (spec.discretization == "alpha" && spec.alpha == 0.5);
+  }
+  template <class S, class F>
+  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
+    const DlaOptions opt = solver_options(spec);
+    if (spec.composition != "none") {
+      if (!symmetric(spec)) throw std::invalid_argument("the DLA composes only with a self-adjoint discretization");
+      const Composition& c = composition(spec.composition);
+      if (spec.discretization == "alpha") {
+        ComposedDla<S, AlphaDiscretization> st(sys, AlphaDiscretization{spec.alpha}, opt, c);
+        return f(st);
+      }
+      ComposedDla<S, SymmetricDiscretization> st(sys, SymmetricDiscretization{spec.alpha}, opt, c);
+      return f(st);
+    }
+    if (spec.discretization == "alpha") {
+      DlaStepper<S, AlphaDiscretization> st(sys, AlphaDiscretization{spec.alpha}, opt);
+      return f(st);
+    }
+    if (spec.discretization != "symmetric")
+      throw std::invalid_argument("unknown discretization \"" + spec.discretization + "\"");
+    DlaStepper<S, SymmetricDiscretization> st(sys, SymmetricDiscretization{spec.alpha}, opt);
+    return f(st);
+  }
+  static std::vector<StudyEntry> study_entries() {
+    auto dla = [](const char* disc, double alpha, const char* group, int style) {
+      MethodSpec s;
+      s.discretization = disc;
+      s.alpha = alpha;
+      return StudyEntry{s, group, style};
+    };
+    StudyEntry tj = dla("alpha", 0.5, "main", 12), tj_sym = dla("symmetric", 0.0, "variant", 14);
+    tj.spec.composition = tj_sym.spec.composition = "triple_jump";
+    return {dla("alpha", 0.5, "main", 11),
+            dla("symmetric", 0.0, "main", 13),
+            dla("alpha", 0.0, "variant", 15),
+            dla("alpha", 0.25, "variant", 16),
+            dla("alpha", 0.75, "variant", 17),
+            dla("alpha", 1.0, "variant", 18),
+            dla("symmetric", 0.25, "variant", 19),
+            tj,
+            tj_sym};
+  }
 };
 
 }  // namespace nhi

@@ -27,7 +27,9 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
+#include "nhi/method_spec.hpp"
 #include "nhi/stepper.hpp"
 #include "nhi/system.hpp"
 
@@ -86,7 +88,8 @@ class EmbeddedRkStepper {
   static constexpr int lag = 0;
   using VecN = Vec<double, n>;
   using State = OdeState<S>;
-  using Controlled = decltype(boost::numeric::odeint::make_controlled<typename Pair::template stepper<State>>(1.0, 1.0));
+  using Controlled =
+      decltype(boost::numeric::odeint::make_controlled<typename Pair::template stepper<State>>(1.0, 1.0));
 
   explicit EmbeddedRkStepper(const S& sys, EmbeddedRkOptions opt = {})
       : sys_(sys),
@@ -171,5 +174,34 @@ class EmbeddedRkStepper {
   double t_ = 0, dt_ = 0.01;
   long k_ = 0;
 };
+
+// The adaptive explicit pairs rkf78 and dopri5 (embedded_rk.hpp): the
+// scene's tolerance is atol = rtol, h the output interval.  Only the
+// work-precision study runs them (study_methods() lists them there).
+template <class P>
+struct EmbeddedRkMethod {
+  using Pair = P;
+  static constexpr const char* name = Pair::name;
+  static constexpr bool adaptive = true;
+  static std::vector<MethodKey> keys() { return {}; }
+  static constexpr bool reports_p = false;
+  static constexpr double step_cost = 10.0;  // per output interval h
+  static std::string label(const MethodSpec&) { return name; }
+  static bool symmetric(const MethodSpec&) { return false; }
+  template <class S, class F>
+  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
+    EmbeddedRkOptions opt;
+    opt.atol = opt.rtol = spec.tolerance;
+    EmbeddedRkStepper<S, Pair> st(sys, opt);
+    return f(st);
+  }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", Pair::style, true}}; }
+};
+template <class M>
+struct is_embedded_rk : std::false_type {};
+template <class P>
+struct is_embedded_rk<EmbeddedRkMethod<P>> : std::true_type {};
+using Rkf78Method = EmbeddedRkMethod<Rkf78Pair>;
+using Dopri5Method = EmbeddedRkMethod<Dopri5Pair>;
 
 }  // namespace nhi

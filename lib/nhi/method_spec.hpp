@@ -125,6 +125,11 @@ struct MethodKey {
     k.own_default = fallback;
     return k;
   }
+  static MethodKey integer(const char* name, int lo, int hi, int fallback) {
+    MethodKey k = range(name, lo, hi, fallback);
+    k.kind = Kind::kInteger;
+    return k;
+  }
 };
 
 // A method's entry in the studies: "main" methods are in every study;

@@ -1,24 +1,30 @@
 // Methods by name: the one table the runner, every study, the benchmarks and
 // the tests go through, so a method means the same thing everywhere.
 //
-// A *method* is a plain type in the TypeList `Methods` below with
+// A *method* is a plain type in the TypeList `Methods` below, declared once in
+// its own header beside its stepper (DlaMethod in dla_composition.hpp,
+// Rk4Method in rk4.hpp, ReferenceMethod in reference.hpp, the pairs in
+// embedded_rk.hpp, Mp06Method, DiscreteGradientMethod, SparkMethod in theirs):
 //   static constexpr const char* name;          // the scene's "method" value
+//   static std::vector<MethodKey> keys();       // its own scene keys, checks, defaults (method_spec.hpp)
 //   static constexpr bool adaptive;             // h is the output interval, not its step
-//   static std::vector<MethodKey> keys();       // its own scene keys (method_spec.hpp)
 //   static bool symmetric(const MethodSpec&);   // self-adjoint: then it accepts a
 //                                               // MethodSpec::composition (composition.hpp)
 //   static constexpr bool reports_p;            // its samples carry p and lambda
-//   template <class S, class F> static auto with_stepper(const S&, const MethodSpec&, F&& f);
-//   static std::vector<StudyEntry> study_entries();   // what the studies run of it
-//   static std::string label(const MethodSpec&);      // its label before "+composition",
-//                                                     // the key of its style in plots/style.gp
+//   static std::string label(const MethodSpec&);      // its label before "+composition"
 //   static constexpr double step_cost;                // a step (one stage) in RK4 steps of the
 //                                                     // same scene, for scheduling the studies' cells
-// which builds the stepper the spec describes and returns f(stepper).  Adding a
-// method is one header (its stepper and this small struct, e.g. mp06.hpp) and
-// one entry in `Methods` (with its #include); it then runs through `nhi run`,
-// every study (study_methods() below), bench_steps and the typed method-contract
-// tests (tests/test_methods.cpp).
+//   static std::vector<StudyEntry> study_entries();   // what the studies run of it: group,
+//                                                     // line style in the figures, external or not
+//   template <class S, class F> static auto with_stepper(const S&, const MethodSpec&, F&& f);
+// where with_stepper builds the stepper the spec describes and returns
+// f(stepper); its order, symmetry and the rest are the stepper's traits().
+// Adding a method is its header (and body), one entry in `Methods` (with its
+// #include), and a file in lib/src/methods/ that compiles it for every
+// registered system (its `template class` and MethodRun lines); it then runs
+// through `nhi run`, `nhi list`, the Python module, every study
+// (study_methods() below), bench_steps, the figures and the typed
+// method-contract tests (tests/test_methods.cpp, which print its pinned numbers).
 #pragma once
 
 #include <cstdio>
@@ -42,134 +48,6 @@
 #include "nhi/typelist.hpp"
 
 namespace nhi {
-
-struct DlaMethod {
-  static constexpr const char* name = "dla";
-  static constexpr bool adaptive = false;
-  // The paper's discretizations: L_d^alpha, omega_d^alpha (eqs. 9, 13) or the
-  // symmetric L_d^{sym,alpha}, omega_d^{sym,alpha} (eqs. 10, 14); alpha in [0, 1].
-  static std::vector<MethodKey> keys() {
-    return {MethodKey::choice("discretization", &MethodSpec::discretization, {"alpha", "symmetric"}),
-            MethodKey::range("alpha", &MethodSpec::alpha, 0.0, 1.0)};
-  }
-  static constexpr bool reports_p = true;
-  static constexpr double step_cost = 6.0;
-  static std::string label(const MethodSpec& spec) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%s a=%g", spec.discretization == "alpha" ? "dla" : "dla-sym", spec.alpha);
-    return buf;
-  }
-  // Self-adjoint discretizations (alpha = 1/2, the symmetric family) compose:
-  // dla_composition.hpp, README "Methods".
-  static bool symmetric(const MethodSpec& spec) {
-    return spec.discretization == "symmetric" || (spec.discretization == "alpha" && spec.alpha == 0.5);
-  }
-  template <class S, class F>
-  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
-    const DlaOptions opt = solver_options(spec);
-    if (spec.composition != "none") {
-      if (!symmetric(spec)) throw std::invalid_argument("the DLA composes only with a self-adjoint discretization");
-      const Composition& c = composition(spec.composition);
-      if (spec.discretization == "alpha") {
-        ComposedDla<S, AlphaDiscretization> st(sys, AlphaDiscretization{spec.alpha}, opt, c);
-        return f(st);
-      }
-      ComposedDla<S, SymmetricDiscretization> st(sys, SymmetricDiscretization{spec.alpha}, opt, c);
-      return f(st);
-    }
-    if (spec.discretization == "alpha") {
-      DlaStepper<S, AlphaDiscretization> st(sys, AlphaDiscretization{spec.alpha}, opt);
-      return f(st);
-    }
-    if (spec.discretization != "symmetric")
-      throw std::invalid_argument("unknown discretization \"" + spec.discretization + "\"");
-    DlaStepper<S, SymmetricDiscretization> st(sys, SymmetricDiscretization{spec.alpha}, opt);
-    return f(st);
-  }
-  static std::vector<StudyEntry> study_entries() {
-    auto dla = [](const char* disc, double alpha, const char* group, int style) {
-      MethodSpec s;
-      s.discretization = disc;
-      s.alpha = alpha;
-      return StudyEntry{s, group, style};
-    };
-    StudyEntry tj = dla("alpha", 0.5, "main", 12), tj_sym = dla("symmetric", 0.0, "variant", 14);
-    tj.spec.composition = tj_sym.spec.composition = "triple_jump";
-    return {dla("alpha", 0.5, "main", 11),
-            dla("symmetric", 0.0, "main", 13),
-            dla("alpha", 0.0, "variant", 15),
-            dla("alpha", 0.25, "variant", 16),
-            dla("alpha", 0.75, "variant", 17),
-            dla("alpha", 1.0, "variant", 18),
-            dla("symmetric", 0.25, "variant", 19),
-            tj,
-            tj_sym};
-  }
-};
-
-struct Rk4Method {
-  static constexpr const char* name = "rk4";
-  static constexpr bool adaptive = false;
-  static std::vector<MethodKey> keys() { return {}; }
-  static constexpr bool reports_p = false;
-  static constexpr double step_cost = 1.0;
-  static std::string label(const MethodSpec&) { return name; }
-  static bool symmetric(const MethodSpec&) { return false; }
-  template <class S, class F>
-  static auto with_stepper(const S& sys, const MethodSpec&, F&& f) {
-    Rk4Stepper<S> st(sys);
-    return f(st);
-  }
-  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", 51}}; }
-};
-
-// The reference solution (scene value "benchmark", kept for the runner's contract).
-struct ReferenceMethod {
-  static constexpr const char* name = "benchmark";
-  static constexpr bool adaptive = true;
-  static std::vector<MethodKey> keys() { return {}; }
-  static constexpr bool reports_p = false;
-  static constexpr double step_cost = 30.0;  // per output interval h
-  static std::string label(const MethodSpec&) { return "reference"; }
-  static bool symmetric(const MethodSpec&) { return false; }
-  template <class S, class F>
-  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
-    ReferenceOptions opt;
-    opt.rtol = opt.atol = spec.tolerance;
-    ReferenceStepper<S> st(sys, opt);
-    return f(st);
-  }
-  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", 10}}; }
-};
-
-// The adaptive explicit pairs rkf78 and dopri5 (embedded_rk.hpp): the
-// scene's tolerance is atol = rtol, h the output interval.  Only the
-// work-precision study runs them (study_methods() lists them there).
-template <class P>
-struct EmbeddedRkMethod {
-  using Pair = P;
-  static constexpr const char* name = Pair::name;
-  static constexpr bool adaptive = true;
-  static std::vector<MethodKey> keys() { return {}; }
-  static constexpr bool reports_p = false;
-  static constexpr double step_cost = 10.0;  // per output interval h
-  static std::string label(const MethodSpec&) { return name; }
-  static bool symmetric(const MethodSpec&) { return false; }
-  template <class S, class F>
-  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
-    EmbeddedRkOptions opt;
-    opt.atol = opt.rtol = spec.tolerance;
-    EmbeddedRkStepper<S, Pair> st(sys, opt);
-    return f(st);
-  }
-  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", Pair::style, true}}; }
-};
-template <class M>
-struct is_embedded_rk : std::false_type {};
-template <class P>
-struct is_embedded_rk<EmbeddedRkMethod<P>> : std::true_type {};
-using Rkf78Method = EmbeddedRkMethod<Rkf78Pair>;
-using Dopri5Method = EmbeddedRkMethod<Dopri5Pair>;
 
 // Every method the library has.
 using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod, Mp06Method, DiscreteGradientMethod, SparkMethod,
@@ -268,7 +146,7 @@ auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
 // by the work-precision study only, over tolerances.
 struct StudyMethod {
   MethodSpec spec;
-  std::string group;  // "main", "variant" or "costly"
+  std::string group;      // "main", "variant" or "costly"
   bool external = false;  // the work-precision study's adaptive pairs
   int style = 99;         // its line style in the figures (StudyEntry)
   std::string label() const { return spec.label(); }

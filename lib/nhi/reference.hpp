@@ -17,8 +17,10 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "nhi/integrate.hpp"
+#include "nhi/method_spec.hpp"
 #include "nhi/stepper.hpp"
 #include "nhi/system.hpp"
 
@@ -182,5 +184,24 @@ void reference_solution(const S& sys, const Vec<double, S::n>& q0, const Vec<dou
     return true;
   });
 }
+
+// The reference solution (scene value "benchmark", kept for the runner's contract).
+struct ReferenceMethod {
+  static constexpr const char* name = "benchmark";
+  static constexpr bool adaptive = true;
+  static std::vector<MethodKey> keys() { return {}; }
+  static constexpr bool reports_p = false;
+  static constexpr double step_cost = 30.0;  // per output interval h
+  static std::string label(const MethodSpec&) { return "reference"; }
+  static bool symmetric(const MethodSpec&) { return false; }
+  template <class S, class F>
+  static auto with_stepper(const S& sys, const MethodSpec& spec, F&& f) {
+    ReferenceOptions opt;
+    opt.rtol = opt.atol = spec.tolerance;
+    ReferenceStepper<S> st(sys, opt);
+    return f(st);
+  }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", 10}}; }
+};
 
 }  // namespace nhi

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
+#include "nhi/method_spec.hpp"
 #include "nhi/stepper.hpp"
 #include "nhi/system.hpp"
 
@@ -75,6 +77,23 @@ class Rk4Stepper {
   S sys_;
   VecN q_ = VecN::Zero(), v_ = VecN::Zero();
   long steps_ = 0;
+};
+
+// The method table's entry (methods.hpp): "rk4".
+struct Rk4Method {
+  static constexpr const char* name = "rk4";
+  static constexpr bool adaptive = false;
+  static std::vector<MethodKey> keys() { return {}; }
+  static constexpr bool reports_p = false;
+  static constexpr double step_cost = 1.0;
+  static std::string label(const MethodSpec&) { return name; }
+  static bool symmetric(const MethodSpec&) { return false; }
+  template <class S, class F>
+  static auto with_stepper(const S& sys, const MethodSpec&, F&& f) {
+    Rk4Stepper<S> st(sys);
+    return f(st);
+  }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", 51}}; }
 };
 
 }  // namespace nhi
