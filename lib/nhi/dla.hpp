@@ -113,9 +113,12 @@ struct DlaStepProblem {
     Vec<T, n> D1;
     if constexpr (std::is_same_v<T, double>) {
       // D2 L_d(q_k, q1) comes from the same partials at the same nodes: kept
-      // for p_{k+1} if q1 is the solution (DlaMap::step).
-      discrete_lagrangian_slots<S, D, T>(sys, disc, h, q0, q1, &D1, last_d2 ? &last_d2->d2 : nullptr);  // eq. 9 / 10
+      // for p_{k+1} if q1 is the solution (DlaMap::step).  (Taken always: a
+      // null D2 would leave a branch per node in the inlined slots.)
+      VecN d2;
+      discrete_lagrangian_slots<S, D, T>(sys, disc, h, q0, q1, &D1, &d2);  // eq. 9 / 10
       if (last_d2) {
+        last_d2->d2 = d2;
         last_d2->at = q1;
         last_d2->valid = true;
       }

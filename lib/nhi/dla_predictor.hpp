@@ -157,8 +157,11 @@ class DlaPredictor {
   // extend: Newton passes may add passes, up to kMaxNewtonPasses, while the
   // last one moved by more than sqrt(eps) of the state's size (at h = 0.4
   // three are often not enough).
-  void refine(const S& sys, const D& disc, double h, const VecN& q, const VecN& p, int passes, bool extend,
-              Memo* memo, VecN* q_guess, VecM* lambda_guess, bool* settled);
+  // (Inlined into the stepper's step, as the passes were before they were a
+  // class of their own: a call here is on every step's path.)
+  [[gnu::always_inline]] inline void refine(const S& sys, const D& disc, double h, const VecN& q, const VecN& p,
+                                            int passes, bool extend, Memo* memo, VecN* q_guess, VecM* lambda_guess,
+                                            bool* settled);
 
   // force_forms(q_{k+1})^T, by the last refine() (for the step's solve).
   const Mat<double, n, mc>& Wt() const { return Wt_; }

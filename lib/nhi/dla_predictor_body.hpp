@@ -152,11 +152,15 @@ void DlaPredictor<S, D>::run_passes(const Step& st, int passes, bool extend, Mem
 template <class S, class D>
 template <bool kNewton>
 void DlaPredictor<S, D>::pass_sums(const Step& st, const VecN& q_guess, PassIn* in) const {
+  // (Locals, stored into *in at the end: the partials take their arguments
+  // by reference, which would keep *in in memory across the node loop.)
   const VecN& q = st.q;
   const double h = st.h;
-  in->vg = (q_guess - q) * st.inv_h;
-  in->rhs = st.p;
-  if constexpr (kNewton) in->u.setZero();
+  const int r = in->r;
+  const VecN vg = (q_guess - q) * st.inv_h;
+  VecN rhs = st.p;
+  VecN u;
+  if constexpr (kNewton) u.setZero();
   for (const Node& nd : st.disc.nodes()) {
     VecN Lq, Lv;
     if constexpr (kNewton) {
@@ -164,16 +168,19 @@ void DlaPredictor<S, D>::pass_sums(const Step& st, const VecN& q_guess, PassIn* 
       const double wcc = nd.weight * nd.c * (1.0 - nd.c);
       if (wcc != 0) {
         VecN dLq;
-        partials_and_curvature(st.sys, qc, in->vg, in->r, &Lq, &dLq);
-        in->u += (h * h * wcc) * dLq;
+        partials_and_curvature(st.sys, qc, vg, r, &Lq, &dLq);
+        u += (h * h * wcc) * dLq;
       } else {
-        lagrangian_partials(st.sys, qc, in->vg, &Lq, &Lv);
+        lagrangian_partials(st.sys, qc, vg, &Lq, &Lv);
       }
     } else {
-      lagrangian_partials(st.sys, VecN((1.0 - nd.c) * q + nd.c * q_guess), in->vg, &Lq, &Lv);
+      lagrangian_partials(st.sys, VecN((1.0 - nd.c) * q + nd.c * q_guess), vg, &Lq, &Lv);
     }
-    in->rhs += (h * nd.weight * (1.0 - nd.c)) * Lq;
+    rhs += (h * nd.weight * (1.0 - nd.c)) * Lq;
   }
+  in->vg = vg;
+  in->rhs = rhs;
+  if constexpr (kNewton) in->u = u;
   in->qbar = (1.0 - st.cbar) * q + st.cbar * q_guess;
 }
 
@@ -215,8 +222,10 @@ bool DlaPredictor<S, D>::constrained_pass(const Step& st, const PassIn& in, Reus
     // whatever the multipliers, so it goes into the guess before Omega is
     // taken at the constraint nodes.  Where the constraint rows read only
     // such coordinates the first pass is then exact in every coordinate, not
-    // the second (first_pass_exact()).  Kept to kappa = 0: on every plain
-    // pass it makes the contact oscillator's midpoint DLA slower.
+    // the second (first_pass_exact(): the symmetric rule alpha = 0 on the
+    // paper's scenes and the contact and chaotic oscillators).  Kept to kappa
+    // = 0: on every plain pass it makes the contact oscillator's midpoint DLA
+    // slower.
     vfree = velocity<S, double>(sys, in.qbar, in.rhs);
     for (int i = 0; i < n; ++i)
       if ((reuse->VWt.row(i).array() == 0.0).all()) (*q_guess)[i] = q[i] + h * vfree[i];
