@@ -20,7 +20,7 @@ template <class S>
 class DiscreteGradientTest : public ::testing::Test {};
 TYPED_TEST_SUITE(DiscreteGradientTest, SeparableSystems);
 
-// The discrete gradient's fixed-point passes (DiscreteGradientStepper::passes)
+// The discrete gradient's fixed-point passes (DiscreteGradientPredictor::run)
 // and the residual check that accepts a settled iterate: every step of the
 // stepper solves the step's equations to round-off by the full measure (the
 // scale with the Jacobian part) and is Newton's solution from the explicit
@@ -36,7 +36,7 @@ TYPED_TEST(DiscreteGradientTest, DiscreteGradientPassesSolveTheStep) {
   using P = typename St::Problem;
   const S sys = make_system<S>();
   // h = 0.4 and the backward stage of a composition: there the passes
-  // contract slowly, get mixed (DiscreteGradientStepper::passes) or give up.
+  // contract slowly, get mixed (DiscreteGradientPredictor::run) or give up.
   for (double h : {0.4, 0.2, -0.3, 0.02, 0.4 / 512}) {
     St st(sys);
     st.start(S::default_q0(), S::default_v0());
@@ -135,7 +135,7 @@ TEST(DiscreteGradientPasses, ExactInTheForceWhereItIsAffine) {
   EXPECT_FALSE(DiscreteGradientStepper<ContactOscillator>(ContactOscillator{}).passes_exact_in_force());
 }
 
-// The Gauss-Seidel first pass (DiscreteGradientStepper::passes): on the
+// The Gauss-Seidel first pass (DiscreteGradientPredictor::run): on the
 // particle (quadratic H, the constraint force misses y, which omega reads)
 // the first pass, exact in the force, takes y1 before it evaluates omega and
 // is then exact from any input (it starts from z1 = z0, map(); a Newton

@@ -97,7 +97,7 @@ TEST(DlaVariational, UnconstrainedDlaIsTheVariationalIntegratorInClosedForm) {
   }
 }
 
-// The stepper's predictor (DlaStepper::next_guess) on a separable scene: the
+// The stepper's predictor (DlaStepper::next_guess, DlaPredictor::refine) on a separable scene: the
 // linear extrapolation misses q_{k+1} by O(h^2), and each fixed-point pass of
 // eq. (6) gains at least one order of h (it moves the guess by O(h) times the
 // guess's error), until round-off.  Measured at the same time t = 1, as the
@@ -326,7 +326,7 @@ TYPED_TEST(DlaTest, StepperFastPathSolvesTheStepToRoundOff) {
 }
 
 // A guess the residual check accepts by its second test (small h) is
-// corrected from its residual (DlaStepper::polish), so that what the
+// corrected from its residual (DlaPredictor::polish), so that what the
 // stepper returns (by either test) is the zero of the
 // residual rounded to the grid, not the passes' fixed point: one full Newton
 // correction (exact Jacobian, matrix 7) from each accepted q_{k+1} moves each
@@ -484,7 +484,7 @@ TYPED_TEST(DlaPredictorTest, PassesWithTheCurvatureOfOneCoordinateAreNewtonSteps
   }
 }
 
-// The Gauss-Seidel pass (DlaStepper::run_passes): where the rule has no
+// The Gauss-Seidel pass (DlaPredictor, dla_predictor_body.hpp): where the rule has no
 // interior node (kappa = 0: alpha = 0 and 1, and the symmetric rule alpha = 0) and the
 // constraint rows read only coordinates the constraint force does not move,
 // the first pass puts those coordinates, exact whatever the multipliers, into

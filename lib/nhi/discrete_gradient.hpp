@@ -31,14 +31,18 @@
 // compositions' fitted orders scatter from random states).  Symmetric on the
 // manifold as RATTLE is: the first 2n equations are invariant under
 // (z0, z1, h) -> (z1, z0, -h), and the reversed step's constraint row holds
-// at z0, which is on the manifold.  No fast passes: Newton from the explicit
-// guess on every step.
+// at z0, which is on the manifold.  Its step is plain Newton (a fresh
+// Jacobian every iteration) from the midpoint form's step where the
+// predictor's passes settle on it (a separable system; O(h^3) from this
+// one's), else from the explicit guess, and then one more update from the
+// accepted iterate (DiscreteGradientStepper::map_endpoint).
 //
 // The constraint rows omega(qbar) move with q1, so lambda is one more unknown of
 // a plain Newton solve (NewtonSolver with nl = 0, LU of the whole Jacobian).
-// On a separable system fixed-point passes come first (passes(), defined in
-// discrete_gradient_body.hpp), and a settled iterate is accepted by a residual
-// check with no derivatives.
+// On a separable system the midpoint form's step starts from fixed-point
+// passes (DiscreteGradientPredictor, discrete_gradient_predictor.hpp), and a
+// settled iterate is accepted by a residual check with no derivatives, or
+// without it where the check would only confirm it (map_midpoint).
 #pragma once
 
 #include <array>
@@ -48,10 +52,12 @@
 #include <string>
 
 #include "nhi/composition.hpp"
+#include "nhi/constraint_rows.hpp"
+#include "nhi/discrete_gradient_predictor.hpp"
 #include "nhi/hamiltonian.hpp"
 #include "nhi/method_spec.hpp"
-#include "nhi/spec_options.hpp"
 #include "nhi/solver.hpp"
+#include "nhi/spec_options.hpp"
 
 namespace nhi {
 
@@ -158,8 +164,9 @@ struct DiscreteGradientProblem {
       }
     }
     for (int i = 0; i < n; ++i) {
-      (*r)[i] = q1[i] - cst<T>(q0[i]) - cst<T>(h) * (Dp[i] - kq[i]);              // (q1 - q0)/h = gradbar_p H
-      (*r)[n + i] = p1[i] - cst<T>(p0[i]) + cst<T>(h) * (Dq[i] - fc[i] + kp[i]);  // (p1 - p0)/h = -gradbar_q H + omega^T lambda
+      (*r)[i] = q1[i] - cst<T>(q0[i]) - cst<T>(h) * (Dp[i] - kq[i]);  // (q1 - q0)/h = gradbar_p H
+      (*r)[n + i] =
+          p1[i] - cst<T>(p0[i]) + cst<T>(h) * (Dq[i] - fc[i] + kp[i]);  // (p1 - p0)/h = -gradbar_q H + omega^T lambda
       if (terms) {
         (*terms)[i] = std::abs(value_of(q1[i])) + std::abs(q0[i]) + std::abs(h) * (sp[i] + ks * sq[i]);
         double fs = 0;
@@ -169,17 +176,7 @@ struct DiscreteGradientProblem {
     }
     if (endpoint) {  // omega(q1) V(q1, p1) = 0
       const Mat<T, m, n> W1 = sys.template omega<T>(q1);
-      const Vec<T, n> v1 = velocity(sys, q1, p1);
-      for (int a = 0; a < m; ++a) {
-        T c = cst<T>(0.0);
-        double cs = 0;
-        for (int j = 0; j < n; ++j) {
-          c += W1(a, j) * v1[j];
-          cs += std::abs(value_of(W1(a, j)) * value_of(v1[j]));
-        }
-        (*r)[2 * n + a] = c;
-        if (terms) (*terms)[2 * n + a] = cs;
-      }
+      velocity_constraint_rows(W1, velocity(sys, q1, p1), 2 * n, r, terms);
       return;
     }
     for (int a = 0; a < m; ++a) {  // omega(qbar) gradbar_p H = 0
@@ -195,9 +192,11 @@ struct DiscreteGradientProblem {
   }
 };
 
-// The stateful discrete-gradient stepper (stepper.hpp), lag 0.  The bodies
-// of the members that solve or differentiate (the constructor, start, map,
-// passes, step, sample, phase) are in discrete_gradient_body.hpp.
+// The stateful discrete-gradient stepper (stepper.hpp), lag 0: the step
+// above, started from the predictor's passes (DiscreteGradientPredictor) or
+// the explicit guess.  The bodies of the members that solve or differentiate
+// (the constructor, start, map, step, sample, phase) are in
+// discrete_gradient_body.hpp.
 template <class S>
 class DiscreteGradientStepper {
  public:
@@ -206,15 +205,18 @@ class DiscreteGradientStepper {
   using VecN = Vec<double, n>;
   using VecM = Vec<double, m>;
   using Problem = DiscreteGradientProblem<S>;
+  using VecY = Vec<double, Problem::ny>;
+  using Predictor = DiscreteGradientPredictor<S>;
 
   // endpoint: the endpoint variant (above).
   explicit DiscreteGradientStepper(const S& sys, SolverOptions options = {}, bool endpoint = false);
   bool endpoint() const { return endpoint_; }
-  // Do the passes see the force exactly (F affine in q; passes())?
-  bool passes_exact_in_force() const { return affine_force_; }
+  const Predictor& predictor() const { return predictor_; }
+  // Do the passes see the force exactly (F affine in q; DiscreteGradientPredictor)?
+  bool passes_exact_in_force() const { return predictor_.exact_in_force(); }
   // Passes made since construction, those after a Gauss-Seidel first pass
   // included (tests/test_discrete_gradient.cpp counts them).
-  long passes_made() const { return passes_made_; }
+  long passes_made() const { return predictor_.passes_made(); }
   // Run the residual check on passes that settled by their move too (map();
   // off by default), and count: steps whose passes so settled, and of those,
   // steps the check did not accept unchanged (tests/test_discrete_gradient.cpp;
@@ -237,23 +239,15 @@ class DiscreteGradientStepper {
 
   void start(const VecN& q0, const VecN& v0);
 
-  // One step (q0, p0) -> (q1, p1); lambda holds the guess and gets the multiplier.
-  StepSummary map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecM* lambda) const;
+  // One step (q0, p0) -> (q1, p1); lambda holds the guess and gets the
+  // multiplier.  (Not const: the predictor keeps its caches and counts.)
+  StepSummary map(double h, const VecN& q0, const VecN& p0, VecN* q1, VecN* p1, VecM* lambda);
 
-  static void unpack(const Vec<double, Problem::ny>& y, VecN* q1, VecN* p1, VecM* lambda) {
+  static void unpack(const VecY& y, VecN* q1, VecN* p1, VecM* lambda) {
     *q1 = y.template head<n>();
     *p1 = y.template segment<n>(n);
     *lambda = y.template tail<m>();
   }
-
-  // Fixed-point passes of the step's equations from y = (q1, p1, lambda), for
-  // a separable system; true when they settle.  The method, and what the
-  // constants below bound, at the definition (discrete_gradient_body.hpp).
-  static constexpr int kPasses = 12, kPredict = 3;
-  static constexpr double kSettled = 4 * std::numeric_limits<double>::epsilon();
-  static constexpr double kStall = 1e-10;
-  static constexpr double kMaxGamma = 4;
-  bool passes(const Problem& prob, Vec<double, Problem::ny>* y, bool allow_curved = true) const;
 
   StepSummary step(double h);
 
@@ -268,13 +262,20 @@ class DiscreteGradientStepper {
   Vec<double, 2 * n> phase() const;
 
  private:
-  // The midpoint form's step (map() without the endpoint variant).
-  template <class Guess>
-  StepSummary map_midpoint(const Problem& prob, const Guess& explicit_guess, VecN* q1, VecN* p1, VecM* lambda) const;
+  // An explicit Stoermer-Verlet-like step with the multiplier lambda (second
+  // order when lambda is): Newton's start where the passes do not settle.
+  VecY explicit_guess(const Problem& prob, const VecM& lambda) const;
+  // map() for each form.
+  StepSummary map_endpoint(const Problem& prob, VecN* q1, VecN* p1, VecM* lambda);
+  StepSummary map_midpoint(const Problem& prob, VecN* q1, VecN* p1, VecM* lambda);
+  // map_midpoint's acceptance of passes settled by their move, into *s;
+  // false where it leaves the step to the solve.
+  bool accept_settled(const Problem& prob, VecY* y, VecN* q1, VecN* p1, VecM* lambda, StepSummary* s);
 
   S sys_;
   SolverOptions options_;
   bool endpoint_ = false;
+  Predictor predictor_;
   VecN q_ = VecN::Zero(), p_ = VecN::Zero();
   VecM lambda_ = VecM::Zero();
   long steps_ = 0;
@@ -290,62 +291,8 @@ class DiscreteGradientStepper {
   VecN q_prev_ = VecN::Zero(), p_prev_ = VecN::Zero();
   double h_prev_ = 0;
   bool has_step_ = false;
-  // F affine in q (passes()): K = dF/dq, M^-1, and Q, M^-1 Q for a step size (curv_).
-  bool affine_force_ = false;
-  std::optional<Mat<double, n, n>> K_;  // when not 0
-  Mat<double, n, n> Minv_ = Mat<double, n, n>::Zero();
-  // The Gauss-Seidel first pass (passes()): constraint_force_misses_omega, and omega_reads.
-  bool gs_ = false;
-  std::array<bool, n> omega_reads_{};
-  mutable long passes_made_ = 0;
-  // Did the last passes end on a plain pass settled by its move (map())?
-  mutable bool settled_by_move_ = false;
   bool check_settled_ = false;
-  mutable long settled_by_move_steps_ = 0, settled_checks_failed_ = 0;
-  struct Curvature {
-    Mat<double, n, n> Q = Mat<double, n, n>::Zero(), MQ = Mat<double, n, n>::Zero();
-    bool ok = false;
-    // The first pass is a Gauss-Seidel pass exact from any input (map()):
-    // gs_ says that M^-1 W^T misses the coordinates omega reads; M^-1 Q W^T
-    // does too where each such coordinate j has one entry in its row of
-    // M^-1, at column k, and its row of M^-1 Q none but there (then gs_
-    // makes W's column k zero, and with it (M^-1 Q W^T)_j).  A
-    // sufficient test, not a necessary one: a system it misses starts its
-    // passes from the explicit guess.
-    bool first_pass_exact = false;
-  };
-  mutable StepSizeCache<Curvature> curv_;  // current(): this step's
-  // Q and M^-1 Q for step size h, kept for the last two step sizes (K_
-  // set; passes() and map()).
-  const Curvature& curvature(double h) const {
-    curv_.at(h, [this](double hh) {
-      Curvature cv;
-      const Mat<double, n, n> hKM = (0.25 * hh * hh) * (*K_ * Minv_);
-      const Mat<double, n, n> G = Mat<double, n, n>::Identity() - hKM;
-      const double det = G.determinant();
-      if (hKM.cwiseAbs().maxCoeff() >= 5e-4 && std::isfinite(det) &&
-          std::abs(det) > 0.5) {  // (h^2/4) K small against M
-        cv.Q = G.inverse();
-        cv.MQ = Minv_ * cv.Q;
-        cv.ok = all_finite(cv.Q);
-        if (cv.ok && gs_) {
-          cv.first_pass_exact = true;
-          for (int j = 0; j < n; ++j) {
-            if (!omega_reads_[j]) continue;
-            int k = -1, entries = 0;
-            for (int c = 0; c < n; ++c)
-              if (Minv_(j, c) != 0.0) ++entries, k = c;
-            bool only_k = entries == 1;
-            for (int c = 0; c < n && only_k; ++c)
-              if (c != k && cv.MQ(j, c) != 0.0) only_k = false;
-            cv.first_pass_exact = cv.first_pass_exact && only_k;
-          }
-        }
-      }
-      return cv;
-    });
-    return curv_.current();
-  }
+  long settled_by_move_steps_ = 0, settled_checks_failed_ = 0;
 };
 
 // The method table's entry (methods.hpp): "discrete_gradient", symmetric, so composable.

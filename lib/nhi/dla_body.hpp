@@ -1,47 +1,19 @@
 // The bodies of DlaStepper's entry points (dla.hpp): the construction, start,
-// step, next_guess and sample that run the step's solve and predictor.  The
-// library compiles them once for every registered system (lib/src/methods/dla_*.cpp);
-// include this header only to instantiate DlaStepper for a system outside the
+// step, next_guess and sample that run the step's solve and predictor (whose
+// bodies, dla_predictor_body.hpp, come with these).  The library compiles
+// them once for every registered system (lib/src/methods/dla_*.cpp); include
+// this header only to instantiate DlaStepper for a system outside the
 // registry (a test's own system).
 #pragma once
 
 #include "nhi/dla.hpp"
+#include "nhi/dla_predictor_body.hpp"
 
 namespace nhi {
 
 template <class S, class D>
 DlaStepper<S, D>::DlaStepper(const S& sys, const D& disc, DlaOptions options)
-    : map_(sys, disc, 0.0, options), omega_memo_(sys) {
-  if constexpr (kPassesSolveMultipliers) {
-    // M^-1 (constant on a separable system) and kappa = sum_c w_c c (1 - c)
-    // for the curvature of the passes (next_guess).
-    Minv_ = inverse_mass_matrix(map_.system());
-    passes_settle_ = constraint_force_misses_omega(map_.system());
-    for (const Node& nd : map_.discretization().nodes()) kappa_ += nd.weight * nd.c * (1.0 - nd.c);
-    // With kappa = 0 and passes that settle, the Gauss-Seidel pass
-    // (run_passes) is exact in its first pass: one pass, then the check.
-    gs_ = passes_settle_ && kappa_ == 0;
-    if (kappa_ != 0) {
-      // The curvature of the passes is used only where K is constant (a
-      // quadratic potential) and not zero (K = 0: nothing to add).
-      if (const auto K = constant_force_jacobian(map_.system())) {
-        affine_potential_force_ = true;
-        if ((K->array() != 0.0).any()) K_ = *K;
-      } else {
-        // A potential of one coordinate r (the robot's V0 sin psi): the
-        // passes take its curvature at every pass (next_guess).
-        const std::array<bool, n> reads = force_reads(map_.system());
-        int count = 0;
-        for (int j = 0; j < n; ++j)
-          if (reads[j]) {
-            ++count;
-            curvature_coordinate_ = j;
-          }
-        if (count != 1) curvature_coordinate_ = -1;
-      }
-    }
-  }
-}
+    : map_(sys, disc, 0.0, options), predictor_(map_.system(), map_.discretization()), omega_memo_(sys) {}
 
 template <class S, class D>
 void DlaStepper<S, D>::start(const VecN& q0, const VecN& v0) {
@@ -56,18 +28,17 @@ void DlaStepper<S, D>::start(const VecN& q0, const VecN& v0) {
 
 template <class S, class D>
 StepSummary DlaStepper<S, D>::step(double h) {
+  // The start: the extrapolation, refined by the predictor's passes where refines(h).
   VecN guess, plain;
   VecM lambda_guess;
   bool settled = false;
   const bool accepted_last = accepted_;
-  predict(h, &guess, &lambda_guess,
-          curvature_coordinate_ >= 0         ? kNewtonPasses
-          : gs_ && accepted_last             ? 1
-          : accepted_last || steps_ % 8 != 0 ? kMinPasses
-                                             : kMaxPasses,
-          &settled, true);
-  const bool predicted = refines(h);  // next_guess refined q
-  if (predicted) plain = extrapolation(h);
+  const bool predicted = start_guess(h, &guess, &lambda_guess);
+  if (predicted) {
+    predictor_.refine(map_.system(), map_.discretization(), h, q_next_, p_next_,
+                      predictor_.passes(accepted_last, steps_), true, &omega_memo_, &guess, &lambda_guess, &settled);
+    plain = extrapolation(h);
+  }
   const VecM lambda_plain = lambda_;
   if (steps_ > 0) {
     q_prev_ = q_curr_;
@@ -79,14 +50,15 @@ StepSummary DlaStepper<S, D>::step(double h) {
   h_prev_ = h_;
   h_ = h;
   map_.set_h(h);
-  // (Only a guess the passes refined is worth the check: where the passes
-  // do not settle, the stages of a composition, none of which follows two
-  // steps in its own direction, get the plain extrapolation, refines().)
+  // The solve of eq. (6) from the guess; first a residual check where the
+  // passes settled, or where they refined a guess and the last check accepted
+  // (the stages of a composition that follow no two steps in their own
+  // direction get the plain extrapolation where the passes do not settle, refines()).
   const bool check = settled || (accepted_last && predicted);
   StepSummary st = map_.step(
       q_curr_, p_curr_, guess, &q_next_, &lambda_, &p_next_, check,
-      [this, h](const Vec<double, n + Map::mc>& r, VecN* q1, VecM* lambda) { polish(h, r, q1, lambda); },
-      predicted ? &guess_Wt_ : nullptr, &omega_memo_);
+      [this, h](const Vec<double, n + Map::mc>& r, VecN* q1, VecM* lambda) { predictor_.polish(h, r, q1, lambda); },
+      predicted ? &predictor_.Wt() : nullptr, &omega_memo_);
   accepted_ = st.ok() && st.jacobians == 0;  // the residual check took the guess
   if (!st.ok() && predicted) {
     // A large step can start outside Newton's basin from the predictor
@@ -94,20 +66,13 @@ StepSummary DlaStepper<S, D>::step(double h) {
     // extrapolation and the last multipliers, before the step fails.
     lambda_ = lambda_plain;
     StepSummary retry = map_.step(q_curr_, p_curr_, plain, &q_next_, &lambda_, &p_next_);
-    retry.iterations += st.iterations;
-    retry.evaluations += st.evaluations;
-    retry.jacobians += st.jacobians;
+    retry.add_cost(st);
     retry.used_fallback = true;  // counted as a fallback step (RunReport::fallbacks)
     if (!retry.ok()) retry.message = "from the predictor: " + st.message + "; from the extrapolation: " + retry.message;
     st = retry;
   }
   ++steps_;
-  if (st.status != SolveStatus::kConverged || !all_finite(q_next_)) {
-    if (st.status == SolveStatus::kConverged) st.failure = FailureKind::kNonFinite;
-    st.status = SolveStatus::kFailed;
-    st.message = "step solve for q_" + std::to_string(steps_) +
-                 " did not converge: " + (st.message.empty() ? "non-finite state" : st.message);
-  }
+  step_failed(&st, all_finite(q_next_), "step solve for q_", steps_);
   return st;
 }
 
@@ -123,9 +88,30 @@ void DlaStepper<S, D>::sample(Sample<n, m>* s) const {
 }
 
 template <class S, class D>
+bool DlaStepper<S, D>::start_guess(double h, VecN* q_guess, VecM* lambda_guess) const {
+  if (steps_ == 0) {
+    *q_guess = q_curr_ + h * v0_;
+    lambda_guess->setZero();
+    return false;
+  }
+  *q_guess = extrapolation(h);
+  if (!one_direction(h)) {
+    *lambda_guess = lambda_;
+    return refines(h);
+  }
+  *lambda_guess = h * (lambda_ / h_ + (h_ / h_prev_) * (lambda_ / h_ - lambda_prev_ / h_prev_));
+  return true;
+}
+
+template <class S, class D>
 void DlaStepper<S, D>::next_guess(double h, VecN* q_guess, VecM* lambda_guess, int passes, bool* settled,
                                   bool extend) const {
-  predict(h, q_guess, lambda_guess, passes, settled, extend);
+  if (settled) *settled = false;
+  if (!start_guess(h, q_guess, lambda_guess)) return;
+  Predictor predictor = predictor_;  // (copies: the stepper's own state is left as it is)
+  typename Map::Problem::Memo memo = omega_memo_;
+  predictor.refine(map_.system(), map_.discretization(), h, q_next_, p_next_, passes, extend, &memo, q_guess,
+                   lambda_guess, settled);
 }
 
 }  // namespace nhi

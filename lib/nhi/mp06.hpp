@@ -29,30 +29,13 @@
 #include <type_traits>
 
 #include "nhi/composition.hpp"
+#include "nhi/constraint_rows.hpp"
 #include "nhi/hamiltonian.hpp"
 #include "nhi/method_spec.hpp"
-#include "nhi/spec_options.hpp"
 #include "nhi/solver.hpp"
+#include "nhi/spec_options.hpp"
 
 namespace nhi {
-
-// The constraint rows omega(q1) v1 = 0 (eq. 4.18's last line) into r from
-// row `first`, with the size of each row's terms (|omega_aj v_j| summed) for
-// the solver's residual scale; shared by the three forms below and by
-// Mp06Stepper::explicit_map's residual check.
-template <class T, int m, int n, int N>
-void mp06_constraint_rows(const Mat<T, m, n>& W1, const Vec<T, n>& v1, int first, Vec<T, N>* r, Vec<double, N>* terms) {
-  for (int a = 0; a < m; ++a) {
-    T c = cst<T>(0.0);
-    double cs = 0;
-    for (int j = 0; j < n; ++j) {
-      c += W1(a, j) * v1[j];
-      cs += std::abs(value_of(W1(a, j)) * value_of(v1[j]));
-    }
-    (*r)[first + a] = c;
-    if (terms) (*terms)[first + a] = cs;
-  }
-}
 
 // Phase form, the equations as stated: y = (q1, p1), lambda; rows (q
 // equation, p equation, constraint).  The stepper solves the velocity form
@@ -105,7 +88,7 @@ struct Mp06PhaseProblem {
                           std::abs(0.5 * h) * (std::abs(F0[i]) + std::abs(value_of(F1[i]))) + fscale;
       }
     }
-    mp06_constraint_rows(W1, v1, ny, r, terms);  // omega(q1) V(q1, p1) = 0
+    velocity_constraint_rows(W1, v1, ny, r, terms);  // omega(q1) V(q1, p1) = 0
   }
 
   // q1, p1 from the solution.
@@ -186,7 +169,7 @@ struct Mp06Problem {
         (*terms)[i] = std::abs(value_of(p1[i])) + std::abs(p0[i]) +
                       std::abs(0.5 * h) * (std::abs(F0[i]) + std::abs(value_of(F1[i]))) + fscale;
     }
-    mp06_constraint_rows(W1, v1, ny, r, terms);  // omega(q1) V(q1, p1) = 0
+    velocity_constraint_rows(W1, v1, ny, r, terms);  // omega(q1) V(q1, p1) = 0
   }
 
   // (q1, p1) from the solution by the phase form's own equations, one
@@ -254,7 +237,7 @@ struct Mp06SeparableProblem {
     Vec<T, n> q1, p1, v1;
     state(lambda, &q1, &p1, &v1);
     const Mat<T, m, n> W1 = sys.template omega<T>(q1);
-    mp06_constraint_rows(W1, v1, 0, r, terms);  // omega(q1) V(q1, p1) = 0
+    velocity_constraint_rows(W1, v1, 0, r, terms);  // omega(q1) V(q1, p1) = 0
   }
 
   // The rounding of q1 (NewtonSolver's rounding_terms, solver.hpp): row a
@@ -409,7 +392,7 @@ class Mp06Stepper {
       W = sys_.template omega<double>(qn);
     }
     VecM r, terms;
-    mp06_constraint_rows(W, vn, 0, &r, &terms);
+    velocity_constraint_rows(W, vn, 0, &r, &terms);
     double rel = 0;
     for (int a = 0; a < m; ++a) {
       if (!std::isfinite(r[a])) return false;

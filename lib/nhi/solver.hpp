@@ -100,8 +100,8 @@ struct has_rounding_terms<P, std::void_t<decltype(std::declval<const P&>().round
 
 struct SolverOptions {
   double tolerance = kDefaultTolerance;  // required relative residual
-  int max_iterations = 20;   // Newton iterations before the fallback
-  bool fallback = true;      // retry a failed Newton with ceres::TinySolver
+  int max_iterations = 20;               // Newton iterations before the fallback
+  bool fallback = true;                  // retry a failed Newton with ceres::TinySolver
   // Keep the factorization (a chord step) while each iteration shrinks the
   // relative residual by at least this factor; refresh the Jacobian otherwise.
   double refresh_ratio = 1e-3;
@@ -123,6 +123,8 @@ class NewtonSolver {
   using VecX = Vec<double, N>;
   using Options = SolverOptions;
   using Summary = StepSummary;
+  // A relative residual at round-off (newton() and the residual check).
+  static constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
 
   explicit NewtonSolver(const P& problem, Options options = {}) : p_(problem), options_(options) {}
 
@@ -140,7 +142,7 @@ class NewtonSolver {
   // approximate inverse of the step matrix the caller has at hand (the DLA:
   // its passes' matrices), since that test accepts a point up to 16 eps of a
   // scale ~|y|/h away, and a predictor's error is smooth from step to step
-  // (dla.hpp, DlaStepper::polish).
+  // (dla_predictor_body.hpp, DlaPredictor::polish).
   template <class Polish = NoPolish>
   Summary solve(VecY* y, VecL* lambda, bool check_guess = false, const Polish& polish = {}) const {
     if constexpr (has_continuation<P>::value) {
@@ -229,9 +231,7 @@ class NewtonSolver {
         const P pj = p_.at_step(s_next * h);
         s = NewtonSolver<P>(pj, sub).solve_from_start(&yt, &lt, false, NoPolish{});
       }
-      total.iterations += s.iterations;
-      total.evaluations += s.evaluations;
-      total.jacobians += s.jacobians;
+      total.add_cost(s);
       if (!s.ok()) {
         if (ds > ds_min) {
           ds *= 0.5;
@@ -276,9 +276,7 @@ class NewtonSolver {
     Summary s = newton(y, lambda);
     if (s.status != SolveStatus::kConverged && options_.fallback) {
       Summary f = tiny_solver(y, lambda);
-      f.iterations += s.iterations;
-      f.evaluations += s.evaluations;
-      f.jacobians += s.jacobians;
+      f.add_cost(s);
       f.used_fallback = true;
       if (f.status != SolveStatus::kConverged) {
         f.message = "Newton: " + s.message + "; TinySolver fallback: " + f.message;
@@ -380,7 +378,6 @@ class NewtonSolver {
   // whether it took the second test.
   bool guess_converged(const VecY& y, const VecL& lambda, Summary* s, VecX* r_out = nullptr,
                        bool* by_bound = nullptr) const {
-    constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
     constexpr double kDelta = 1.0 / (1 << 20);
     VecX r, terms;
     p_.template residual<double>(y, lambda, &r, &terms);
@@ -489,102 +486,130 @@ class NewtonSolver {
     bool schur_ok_ = false;
   };
 
+  // Newton's iterate and what newton() keeps from one iteration to the next.
+  struct Iterate {
+    explicit Iterate(const Mat<double, ny, nl>& Wt) : solver(Wt) {}
+    VecY y;
+    VecL lambda;
+    double prev = std::numeric_limits<double>::infinity();  // the last iteration's relative residual
+    VecX r;
+    Mat<double, N, ny> Jy;
+    LinearSolver solver;
+    bool fresh = true;     // r, Jy were just evaluated with derivatives at the iterate
+    VecX scale;            // of the rows, at the point of the last Jacobian
+    double rel = 0;        // the relative residual of r
+    bool rounded = false;  // the rounding terms are in scale
+  };
+
   // Newton with the Jacobian refreshed only when the last step contracted the
   // residual by less than 1e-3 (otherwise the factorization is reused): near
   // round-off the converged iterate is the same, with fewer Jet passes.
+  // Converged: within tolerance, and at round-off or no longer improving
+  // (accepts), after the start's own update if it is the start (start_update).
+  Summary newton(VecY* y_io, VecL* lambda_io) const {
+    Summary s;
+    Iterate x(p_.Wt());
+    x.y = *y_io;
+    x.lambda = *lambda_io;
+    x.rel = evaluate(x.y, x.lambda, &x.r, &x.Jy, &x.scale);
+    ++s.evaluations;
+    ++s.jacobians;
+    for (int it = 0;; ++it) {
+      s.relative_residual = x.rel;
+      if (!std::isfinite(x.rel)) {
+        s.message = "non-finite residual";
+        s.failure = FailureKind::kNonFinite;
+        return s;
+      }
+      add_rounding_terms(&x, &s);
+      if (accepts(x)) {
+        if (it == 0) start_update(&x);
+        break;
+      }
+      if (it == options_.max_iterations) {
+        if (x.rel <= options_.tolerance) break;
+        s.message =
+            "no convergence in " + std::to_string(it) + " iterations (relative residual " + std::to_string(x.rel) + ")";
+        s.failure = FailureKind::kSolve;
+        return s;
+      }
+      if (!iterate(&x, &s)) {
+        s.message = "singular step matrix (eq. 7)";
+        s.failure = FailureKind::kSolve;
+        return s;
+      }
+    }
+    *y_io = x.y;
+    *lambda_io = x.lambda;
+    s.status = SolveStatus::kConverged;
+    return s;
+  }
+
+  // The rounding terms (has_rounding_terms), where they can decide: they
+  // only grow the scale, so a residual at 16 eps without them does not
+  // need them, and one above tolerance without them is not accepted
+  // (stricter than the whole scale only where the rounding terms exceed
+  // tolerance / (16 eps), ~280 times, the rest of it).  Evaluated at the
+  // iterate, counted as an evaluation.
+  void add_rounding_terms(Iterate* x, Summary* s) const {
+    if constexpr (has_rounding_terms<P>::value) {
+      if (!x->rounded && x->rel <= options_.tolerance && !(x->rel <= kRoundoff)) {
+        VecX extra;
+        p_.rounding_terms(x->y, x->lambda, &extra);
+        ++s->evaluations;
+        x->scale += extra;
+        x->rounded = true;
+        x->rel = 0;
+        for (int i = 0; i < N; ++i) x->rel = std::max(x->rel, ratio(x->r[i], x->scale[i]));
+        s->relative_residual = x->rel;
+      }
+    }
+  }
+
   // Converged: within tolerance, and at round-off or no longer improving.
+  bool accepts(const Iterate& x) const {
+    return x.rel <= options_.tolerance && (x.rel <= kRoundoff || x.rel > 0.5 * x.prev);
+  }
+
   // A start that is already at round-off still takes the update its first
   // evaluation paid the Jacobian for (no new evaluation; not counted as an
-  // iteration, like DlaStepper::polish): otherwise an accepted start keeps
+  // iteration, like DlaPredictor::polish): otherwise an accepted start keeps
   // its error, and where the solution moves by round-off from step to step
   // the residual of the next start creeps past the round-off test (mp06 on
   // the sleigh, where lambda = 0 while it runs straight: without the update
   // the residual of the last multiplier grows by ~2e-16 a step until it
   // passes 16 eps of its scale, and an iteration follows).
-  Summary newton(VecY* y_io, VecL* lambda_io) const {
-    constexpr double kRoundoff = 16 * std::numeric_limits<double>::epsilon();
-    Summary s;
-    VecY y = *y_io;
-    VecL lambda = *lambda_io;
-    double prev = std::numeric_limits<double>::infinity();
-    VecX r;
-    Mat<double, N, ny> Jy;
-    LinearSolver solver(p_.Wt());
-    bool fresh = true;  // r, Jy were just evaluated with derivatives at the iterate
-    VecX scale;         // of the rows, at the point of the last Jacobian
-    double rel = evaluate(y, lambda, &r, &Jy, &scale);
-    ++s.evaluations;
-    ++s.jacobians;
-    bool rounded = false;  // the rounding terms are in scale
-    for (int it = 0;; ++it) {
-      s.relative_residual = rel;
-      if (!std::isfinite(rel)) {
-        s.message = "non-finite residual";
-        s.failure = FailureKind::kNonFinite;
-        return s;
-      }
-      // The rounding terms (has_rounding_terms), where they can decide: they
-      // only grow the scale, so a residual at 16 eps without them does not
-      // need them, and one above tolerance without them is not accepted
-      // (stricter than the whole scale only where the rounding terms exceed
-      // tolerance / (16 eps), ~280 times, the rest of it).  Evaluated at the
-      // iterate, counted as an evaluation.
-      if constexpr (has_rounding_terms<P>::value) {
-        if (!rounded && rel <= options_.tolerance && !(rel <= kRoundoff)) {
-          VecX extra;
-          p_.rounding_terms(y, lambda, &extra);
-          ++s.evaluations;
-          scale += extra;
-          rounded = true;
-          rel = 0;
-          for (int i = 0; i < N; ++i) rel = std::max(rel, ratio(r[i], scale[i]));
-          s.relative_residual = rel;
-        }
-      }
-      if (rel <= options_.tolerance && (rel <= kRoundoff || rel > 0.5 * prev)) {
-        if (it == 0) {  // the start's own update (above)
-          solver.factor(Jy);
-          const VecX dx = solver.solve(r);
-          if (all_finite(dx)) {
-            y -= dx.template head<ny>();
-            lambda -= dx.template tail<nl>();
-          }
-        }
-        break;
-      }
-      if (it == options_.max_iterations) {
-        if (rel <= options_.tolerance) break;
-        s.message =
-            "no convergence in " + std::to_string(it) + " iterations (relative residual " + std::to_string(rel) + ")";
-        s.failure = FailureKind::kSolve;
-        return s;
-      }
-      if (fresh) solver.factor(Jy);
-      const VecX dx = solver.solve(r);
-      if (!all_finite(dx)) {
-        s.message = "singular step matrix (eq. 7)";
-        s.failure = FailureKind::kSolve;
-        return s;
-      }
-      y -= dx.template head<ny>();
-      lambda -= dx.template tail<nl>();
-      prev = rel;
-      ++s.iterations;
-      rel = evaluate_value(y, lambda, scale, &r);
-      ++s.evaluations;
-      fresh = false;
-      if (!(rel <= options_.refresh_ratio * prev) && !(rel <= kRoundoff)) {  // slow contraction: refresh the Jacobian
-        rel = evaluate(y, lambda, &r, &Jy, &scale);
-        ++s.evaluations;
-        ++s.jacobians;
-        fresh = true;
-        rounded = false;
-      }
+  void start_update(Iterate* x) const {
+    x->solver.factor(x->Jy);
+    const VecX dx = x->solver.solve(x->r);
+    if (all_finite(dx)) {
+      x->y -= dx.template head<ny>();
+      x->lambda -= dx.template tail<nl>();
     }
-    *y_io = y;
-    *lambda_io = lambda;
-    s.status = SolveStatus::kConverged;
-    return s;
+  }
+
+  // One Newton (or chord) iteration and the residual after it; the Jacobian
+  // again where it contracted by less than refresh_ratio.  False where the
+  // step matrix is singular.
+  bool iterate(Iterate* x, Summary* s) const {
+    if (x->fresh) x->solver.factor(x->Jy);
+    const VecX dx = x->solver.solve(x->r);
+    if (!all_finite(dx)) return false;
+    x->y -= dx.template head<ny>();
+    x->lambda -= dx.template tail<nl>();
+    x->prev = x->rel;
+    ++s->iterations;
+    x->rel = evaluate_value(x->y, x->lambda, x->scale, &x->r);
+    ++s->evaluations;
+    x->fresh = false;
+    if (!(x->rel <= options_.refresh_ratio * x->prev) && !(x->rel <= kRoundoff)) {  // slow contraction: refresh
+      x->rel = evaluate(x->y, x->lambda, &x->r, &x->Jy, &x->scale);
+      ++s->evaluations;
+      ++s->jacobians;
+      x->fresh = true;
+      x->rounded = false;
+    }
+    return true;
   }
 
  public:
@@ -623,16 +648,11 @@ class NewtonSolver {
   };
 
  private:
+  // The fallback: ceres::TinySolver (Levenberg-Marquardt) on FallbackCost.
   Summary tiny_solver(VecY* y_io, VecL* lambda_io) const {
     const FallbackCost cost{this};
     ceres::TinySolver<FallbackCost> solver;
-    return tiny_solve(cost, &solver, y_io, lambda_io);
-  }
-
-  template <class Cost, class Solver>
-  Summary tiny_solve(const Cost& cost, Solver* solver_ptr, VecY* y_io, VecL* lambda_io) const {
     Summary s;
-    Solver& solver = *solver_ptr;
     solver.options.max_num_iterations = 200;
     solver.options.gradient_tolerance = 0;
     solver.options.parameter_tolerance = 1e-15;  // relative step below round-off: stop

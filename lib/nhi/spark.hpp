@@ -32,11 +32,11 @@
 #include <string>
 
 #include "nhi/composition.hpp"
+#include "nhi/constraint_rows.hpp"
 #include "nhi/hamiltonian.hpp"
 #include "nhi/method_spec.hpp"
-#include "nhi/spec_options.hpp"
-#include "nhi/mp06.hpp"
 #include "nhi/solver.hpp"
+#include "nhi/spec_options.hpp"
 
 namespace nhi {
 
@@ -195,7 +195,7 @@ struct SparkProblem {
     const Vec<T, n> q1 = stage_q(y, s - 1), p1 = y.template segment<n>(kP1);
     const Vec<T, n> v1 = velocity(sys, q1, p1);
     const Mat<T, m, n> W1 = sys.template omega<T>(q1);
-    mp06_constraint_rows(W1, v1, kL + m * (s - 1), r, terms);
+    velocity_constraint_rows(W1, v1, kL + m * (s - 1), r, terms);
   }
 
   // The residual's y-Jacobian, assembled from each stage's derivatives in its
@@ -234,7 +234,7 @@ struct SparkProblem {
       Vec<J, m> G;
       if (end) {  // row (6)'s sum, as residual() forms it
         Vec<J, m> r6;
-        mp06_constraint_rows<J, m, n, m>(W, V, 0, &r6, nullptr);
+        velocity_constraint_rows<J, m, n, m>(W, V, 0, &r6, nullptr);
         G = r6;
       } else {
         G = W * V;

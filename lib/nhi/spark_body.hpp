@@ -1,6 +1,6 @@
 // The bodies of SparkStepper's members (spark.hpp): start, map, step, sample
 // and phase, which run the step's solve and its autodiff.  Included by the
-// library's explicit instantiations (lib/src/methods/spark.cpp), which compile
+// library's explicit instantiations (lib/src/methods/spark*.cpp), which compile
 // them once for every registered system, and by code that instantiates
 // SparkStepper for a system outside the registry; code that includes only
 // spark.hpp links to the library's instances.
@@ -65,7 +65,7 @@ auto SparkStepper<S, s>::phase() const -> Vec<double, 2 * n> {
 
 }  // namespace nhi
 
-// The library compiles SparkStepper for every registered system (lib/src/methods/spark.cpp):
+// The library compiles SparkStepper for every registered system (lib/src/methods/spark*.cpp):
 // where this body is included, those instances are declared, not compiled again.
 #include "nhi/systems/registry.hpp"
 // clang-format off
