@@ -245,38 +245,38 @@ std::vector<Config> all_configs() {
 }
 
 // What the result's numbers mean.
-json study_config(){
-    return json{{"T_final_error", kT_final},
-                {"T_energy", kT_energy},
-                {"T_energy_short", kT_energy_short},
-                {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
-                {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods), j = 0 ... " +
-                                std::to_string(kFinestJCostly) +
-                                " (SPARK, stages >= " + std::to_string(kCostlyMinStages) + ", no T_long run)"},
-                {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
-                                   tol_range(kTightestTolPairs) + " (the explicit pairs)"},
-                {"cpu",
-                 "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms, "
-                 "the median of 3 such timings (each cpu_* has its range [min, max] of the 3 in cpu_*_range); "
-                 "for fixed-step methods cpu_energy is cpu_energy_short times T_energy / T_energy_short (the same "
-                 "steps, 100 times as many); for the reference solution (CVODE, output every 0.1) the diagnosed run "
-                 "itself is the first of the 3 timings of cpu_energy when it took >= 0.5 s"},
-                {"energy_error",
-                 "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output "
-                 "point every 0.1 (CVODE)"},
-                {"energy_error_short", "the same over [0, T_energy_short]"},
-                {"T_long", kT_long},
-                {"long_scenes", kLongScenes},
-                {"energy_error_long",
-                 "max |E - E0| over [0, T_long] (a separate run), on long_scenes only, for fixed steps h >= 0.1 (h "
-                 "= 0.4 for energy-preserving methods) and the explicit adaptive pairs at every tolerance (dopri5 "
-                 "down to 1e-10); cpu_energy_long is cpu_energy scaled by the ratio of steps (fixed-step) or of "
-                 "right-hand-side evaluations counted in the two runs (the adaptive pairs); status_long = failed "
-                 "(and no max_energy_error_long) when that run failed"},
-                {"failed",
-                 "a run is stopped and failed (status = failed, not timed) at a step failure or where |E - E0| "
-                 "passes max(|E0|, 1): no target is met then, and a non-conservative method's energy, and with it "
-                 "an adaptive method's step count, can grow without bound"}}};
+json study_config() {
+  return json{{"T_final_error", kT_final},
+              {"T_energy", kT_energy},
+              {"T_energy_short", kT_energy_short},
+              {"reference", "CVODE Adams rtol = atol = 1e-13 at T_final_error"},
+              {"h_fixed", "0.4 / 2^j, j = 0 ... " + std::to_string(kFinestJ) + " (fixed-step methods), j = 0 ... " +
+                              std::to_string(kFinestJCostly) +
+                              " (SPARK, stages >= " + std::to_string(kCostlyMinStages) + ", no T_long run)"},
+              {"tolerances", tol_range(kTightestTolReference) + " (the reference solution), " +
+                                 tol_range(kTightestTolPairs) + " (the explicit pairs)"},
+              {"cpu",
+               "per-thread CPU seconds of a run without diagnostics, averaged over repeats totalling >= 50 ms, "
+               "the median of 3 such timings (each cpu_* has its range [min, max] of the 3 in cpu_*_range); "
+               "for fixed-step methods cpu_energy is cpu_energy_short times T_energy / T_energy_short (the same "
+               "steps, 100 times as many); for the reference solution (CVODE, output every 0.1) the diagnosed run "
+               "itself is the first of the 3 timings of cpu_energy when it took >= 0.5 s"},
+              {"energy_error",
+               "max |E - E0| over [0, T_energy], at every step (fixed-step), accepted step (odeint) or output "
+               "point every 0.1 (CVODE)"},
+              {"energy_error_short", "the same over [0, T_energy_short]"},
+              {"T_long", kT_long},
+              {"long_scenes", kLongScenes},
+              {"energy_error_long",
+               "max |E - E0| over [0, T_long] (a separate run), on long_scenes only, for fixed steps h >= 0.1 (h "
+               "= 0.4 for energy-preserving methods) and the explicit adaptive pairs at every tolerance (dopri5 "
+               "down to 1e-10); cpu_energy_long is cpu_energy scaled by the ratio of steps (fixed-step) or of "
+               "right-hand-side evaluations counted in the two runs (the adaptive pairs); status_long = failed "
+               "(and no max_energy_error_long) when that run failed"},
+              {"failed",
+               "a run is stopped and failed (status = failed, not timed) at a step failure or where |E - E0| "
+               "passes max(|E0|, 1): no target is met then, and a non-conservative method's energy, and with it "
+               "an adaptive method's step count, can grow without bound"}};
 }
 
 // A finished run's timings (cpu_final, cpu_energy_short, cpu_energy, and
