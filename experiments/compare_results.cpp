@@ -27,6 +27,8 @@
 // error or unreadable JSON.
 #include <nlohmann/json.hpp>
 
+#include <fnmatch.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -80,7 +82,10 @@ struct Comparer {
   double tol = 1e-9;  // from --tol
 
   bool skipped(const std::string& key) const {
-    return SKIP_KEYS.count(key) || extra_skip.count(key) || SKIP_KEYS_IN_FILE.count({file, key});
+    // --ignore-key takes a shell pattern ('cpu_*').
+    const bool ignored = std::any_of(extra_skip.begin(), extra_skip.end(),
+                                     [&](const std::string& p) { return fnmatch(p.c_str(), key.c_str(), 0) == 0; });
+    return SKIP_KEYS.count(key) || ignored || SKIP_KEYS_IN_FILE.count({file, key});
   }
   // A study's `stats` (ranks, threads, per-rank cells and busy times: how
   // the run was split, not what it computed); a run's `stats` (Newton
