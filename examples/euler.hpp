@@ -1,9 +1,10 @@
 // A method of one's own, as a throwaway example: explicit Euler on the
 // index-reduced ODE.  The stepper (stepper.hpp's role) runs out of tree like
 // the library's, through nhi::integrate (user_system.cpp); with the method
-// struct and its line in `Methods` (methods.hpp), the same file as
-// lib/nhi/euler.hpp adds "method": "euler" to the library (README, "Adding a
-// method").
+// struct, its line in `Methods` (methods.hpp) and a file in lib/src/methods/
+// compiling its MethodRun, the same file as lib/nhi/euler.hpp adds
+// "method": "euler" to the library (README, "Adding a method"; the branch
+// throwaway-euler does it with a scene key of its own).
 #pragma once
 #include "nhi/method_spec.hpp"
 #include "nhi/stepper.hpp"
