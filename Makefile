@@ -127,18 +127,18 @@ reproduce: build
 # Long runs (long_horizon), many initial states (states, the fate map) and the
 # timed studies (work_precision, the benchmark) take most of the CPU time of
 # the results; make reproduce keeps the committed ones and refuses any made
-# before the last change to the code it depends on (experiments/check_fresh.sh).
+# before the last change to the code it depends on (experiments/tools/check_fresh.sh).
 # Their rules exist only under make sweep (SWEEP=1), so that a newer binary
 # does not make reproduce run them again.
 SWEEP_RESULTS := results/long_horizon.json results/states.json results/fate_map.json results/fate_map_roots.json \
                  results/work_precision.json results/step_costs.json
 check-sweep:
-	experiments/check_fresh.sh results/long_horizon.json experiments/study_long_horizon.cpp
-	experiments/check_fresh.sh results/states.json experiments/study_states.cpp
-	experiments/check_fresh.sh results/fate_map.json experiments/study_fate_map.cpp
-	experiments/check_fresh.sh results/fate_map_roots.json experiments/study_fate_map.cpp
-	experiments/check_fresh.sh results/work_precision.json experiments/study_work_precision.cpp
-	experiments/check_fresh.sh results/step_costs.json experiments/bench_steps.cpp
+	experiments/tools/check_fresh.sh results/long_horizon.json experiments/studies/study_long_horizon.cpp
+	experiments/tools/check_fresh.sh results/states.json experiments/studies/study_states.cpp
+	experiments/tools/check_fresh.sh results/fate_map.json experiments/studies/study_fate_map.cpp
+	experiments/tools/check_fresh.sh results/fate_map_roots.json experiments/studies/study_fate_map.cpp
+	experiments/tools/check_fresh.sh results/work_precision.json experiments/studies/study_work_precision.cpp
+	experiments/tools/check_fresh.sh results/step_costs.json experiments/studies/bench_steps.cpp
 sweep: build
 	$(MAKE) -j$(JOBS) SWEEP=1 sweep-results
 	$(MAKE) -j$(JOBS) study-long-horizon study-work-precision fate-map-figures
@@ -253,14 +253,14 @@ endif
 
 # Markdown tables of the results (results/summary.md), and the README's
 # generated tables copied from it and from `nhi list --markdown`.
-results/summary.md: experiments/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
+results/summary.md: experiments/tools/summarize.sh results/convergence.json results/long_horizon.json results/work_precision.json results/poincare.json \
     results/stability.json results/geometry.json results/fate_map.json results/fate_map_roots.json results/states.json \
     results/global_error.json results/step_costs.json \
     $(RUNS) $(COMPANION_RUNS) $(NHI)
-	experiments/summarize.sh results $(NHI) > $@.tmp && mv $@.tmp $@
+	experiments/tools/summarize.sh results $(NHI) > $@.tmp && mv $@.tmp $@
 readme-tables: results/summary.md $(NHI)
 	d=$$(mktemp -d) && { $(NHI) list --markdown > $$d/list.md && \
-	  experiments/readme_tables.sh results/summary.md $$d/list.md; rc=$$?; rm -rf $$d; exit $$rc; }
+	  experiments/tools/readme_tables.sh results/summary.md $$d/list.md; rc=$$?; rm -rf $$d; exit $$rc; }
 
 # ---- The fate map: h x epsilon x methods x 100 initial states on the contact
 # oscillators, sharded over MPI ranks like every study.  RANKS=N runs it under
@@ -289,7 +289,7 @@ plots/fate_map_%.png: plots/fate_map.gp $(STYLE) results/fate_map.json
 # Its run time with 1, 2 and 4 ranks of one thread each (4 oversubscribes
 # this machine's two cores: a correctness check, not a speed-up).
 sweep-scaling: $(BUILD)/bin/study_fate_map
-	experiments/sweep_scaling.sh $< "$(MPIRUN)" results/fate_map_scaling.json 1 2 4
+	experiments/tools/sweep_scaling.sh $< "$(MPIRUN)" results/fate_map_scaling.json 1 2 4
 
 clean:
 	rm -rf $(BUILD)

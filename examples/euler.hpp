@@ -2,13 +2,13 @@
 // index-reduced ODE.  The stepper (stepper.hpp's role) runs out of tree like
 // the library's, through nhi::integrate (user_system.cpp); with the method
 // struct, its line in `Methods` (methods.hpp) and a file in lib/src/methods/
-// compiling its MethodRun, the same file as lib/nhi/euler.hpp adds
+// compiling its MethodRun, the same file as lib/nhi/methods/explicit/euler.hpp adds
 // "method": "euler" to the library (README, "Adding a method"; the branch
 // throwaway-euler does it with a scene key of its own).
 #pragma once
-#include "nhi/method_spec.hpp"
-#include "nhi/stepper.hpp"
-#include "nhi/system.hpp"
+#include "nhi/methods/method_spec.hpp"
+#include "nhi/roles/stepper.hpp"
+#include "nhi/roles/system.hpp"
 namespace nhi {
 template <class S>
 class EulerStepper {

@@ -15,10 +15,10 @@
 
 #include <cmath>
 
-#include "nhi/system.hpp"
+#include "nhi/roles/system.hpp"
 
 struct KnifeEdge {
-  // What every method needs (nhi/system.hpp: the system concept).
+  // What every method needs (nhi/roles/system.hpp: the system concept).
   static constexpr int n = 3, m = 1;
   double mass = 1.0, inertia = 0.2, g = 9.81, incline = 0.3;  // incline: the plane's angle alpha
 
@@ -43,7 +43,7 @@ struct KnifeEdge {
   }
 
   // Optional fast paths.  L = 1/2 v^T M v - U(q) with M constant: mp06 then
-  // solves for the multiplier alone (nhi/hamiltonian.hpp).
+  // solves for the multiplier alone (nhi/roles/hamiltonian.hpp).
   static constexpr bool separable = true;
   // dL/dq and dL/dqdot by hand: without them the DLA's Jacobian needs a Jet of Jets.
   template <class T>

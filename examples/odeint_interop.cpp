@@ -1,4 +1,4 @@
-// The library's steppers where Boost.Odeint expects a stepper (nhi/odeint.hpp):
+// The library's steppers where Boost.Odeint expects a stepper (nhi/interop/odeint.hpp):
 // the knife edge (knife_edge.hpp) integrated by odeint's integrate_const with
 // odeint's runge_kutta4 on the index-reduced ODE, then with nhi's mp06 by
 // changing the stepper line; integrate_n_steps with mp06's order-4
@@ -13,9 +13,9 @@
 #include <functional>
 
 #include "knife_edge.hpp"
-#include "nhi/composition.hpp"
-#include "nhi/mp06_body.hpp"
-#include "nhi/odeint.hpp"
+#include "nhi/interop/odeint.hpp"
+#include "nhi/methods/composition.hpp"
+#include "nhi/methods/mp06/mp06_body.hpp"
 
 namespace odeint = boost::numeric::odeint;
 using state_type = std::array<double, 6>;  // x = (q, v)

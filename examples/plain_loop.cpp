@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "knife_edge.hpp"
-#include "nhi/mp06_body.hpp"  // mp06's step, compiled here for KnifeEdge
+#include "nhi/methods/mp06/mp06_body.hpp"  // mp06's step, compiled here for KnifeEdge
 
 namespace {
 

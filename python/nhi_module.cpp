@@ -35,7 +35,7 @@
 #include <cmath>
 #include <string>
 
-#include "nhi/scene.hpp"
+#include "nhi/runner/scene.hpp"
 
 namespace py = pybind11;
 using nhi::json;

@@ -6,10 +6,10 @@
 
 #include <random>
 
-#include "nhi/fit.hpp"
-#include "nhi/integrate.hpp"
-#include "nhi/methods.hpp"
-#include "nhi/run.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/readings/fit.hpp"
+#include "nhi/roles/integrate.hpp"
+#include "nhi/runner/run.hpp"
 #include "nhi/systems/registry.hpp"
 
 namespace nhi::test {

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# experiments/check_fresh.sh in a throwaway git repository: a result made at
+# experiments/tools/check_fresh.sh in a throwaway git repository: a result made at
 # the last commit that changed its code passes; one made before it, from a
 # modified tree, at an unknown revision, or with uncommitted changes to its
 # code is refused with exit 1 and one line naming `make sweep`.

@@ -15,7 +15,7 @@
 #include <set>
 #include <sstream>
 
-#include "nhi/scene.hpp"
+#include "nhi/runner/scene.hpp"
 
 namespace {
 

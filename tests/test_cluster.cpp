@@ -1,4 +1,4 @@
-// The studies over MPI ranks (experiments/cluster.hpp, study.hpp map_cells),
+// The studies over MPI ranks (experiments/studies/cluster.hpp, study.hpp map_cells),
 // driven as a cluster user drives them: `mpirun -np N study_... -o F` gives
 // the single-process JSON (timings and meta aside), a failing cell fails the
 // whole run naming the cell, and no failure leaves a result file behind.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# experiments/compare_results.cpp on two tiny result trees: a row inserted in
+# experiments/tools/compare_results.cpp on two tiny result trees: a row inserted in
 # the middle of a labelled method list is one new entry, not a difference in
 # every later row; a number changed in a later row is the one difference (exit
 # 1); the same tree against itself agrees (exit 0); an unlabelled array stays

@@ -4,7 +4,7 @@
 #include <array>
 #include <string>
 
-#include "nhi/dla_body.hpp"
+#include "nhi/methods/dla/dla_body.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {

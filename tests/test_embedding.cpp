@@ -4,7 +4,7 @@
 //    are the same integrator: v_{k+1} = J(q_{k+1}), mu-bar = mu.
 //  - The robot with its circles as unit vectors (a nonlinear embedding, outside
 //    the theorem): a different second-order integrator; how it differs.
-#include "nhi/dla_body.hpp"
+#include "nhi/methods/dla/dla_body.hpp"
 #include "nhi/systems/robot_extrinsic.hpp"
 #include "scenes.hpp"
 

@@ -2,7 +2,7 @@
 // long-horizon study records a run (h = 0.2, 10^6 steps, T = 2e5): each signal
 // is a known fate (bounded, large but flat, drifting, accelerating, a random
 // walk, dissipating, blown up) and the reading must name it.
-#include "nhi/fate.hpp"
+#include "nhi/readings/fate.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,8 +4,8 @@
 //    Euclidean group; its continuous counterpart (eq. 23) along the benchmark.
 //  - Section 5.1: with no constraints the one-step map (q, p) -> (q', p') is
 //    symplectic; with constraints it is not.
-#include "nhi/dla_body.hpp"
-#include "nhi/reference_body.hpp"
+#include "nhi/methods/dla/dla_body.hpp"
+#include "nhi/methods/reference/reference_body.hpp"
 #include "nhi/systems/circle.hpp"
 #include "scenes.hpp"
 

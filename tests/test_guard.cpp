@@ -12,9 +12,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "nhi/guard.hpp"
-#include "nhi/reference.hpp"
-#include "nhi/scene.hpp"
+#include "nhi/methods/reference/reference.hpp"
+#include "nhi/roles/guard.hpp"
+#include "nhi/runner/scene.hpp"
 #include "scenes.hpp"
 
 namespace {

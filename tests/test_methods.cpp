@@ -14,7 +14,7 @@
 #include <optional>
 #include <set>
 
-#include "nhi/reversibility.hpp"
+#include "nhi/readings/reversibility.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {

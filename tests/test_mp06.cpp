@@ -13,7 +13,7 @@
 #include <limits>
 #include <vector>
 
-#include "../experiments/hand_steps.hpp"
+#include "../experiments/studies/hand_steps.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {
@@ -405,7 +405,7 @@ TEST(Mp06, ParticleStepIsTheClosedForm) {
   }
 }
 
-// bench_steps' floor for mp06 on contact_oscillator_nr (experiments/hand_steps.hpp:
+// bench_steps' floor for mp06 on contact_oscillator_nr (experiments/studies/hand_steps.hpp:
 // the step reduced by hand to one scalar equation) is the library's mp06 map:
 // from random parameters and states, single steps at several h, and 2000
 // chained steps at the benchmark's h = 0.2, agree to round-off.

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "nhi/composition.hpp"
-#include "nhi/dla.hpp"
-#include "nhi/mp06.hpp"
-#include "nhi/odeint.hpp"
-#include "nhi/rk4.hpp"
+#include "nhi/interop/odeint.hpp"
+#include "nhi/methods/composition.hpp"
+#include "nhi/methods/dla/dla.hpp"
+#include "nhi/methods/explicit/rk4.hpp"
+#include "nhi/methods/mp06/mp06.hpp"
 #include "nhi/systems/particle.hpp"
 
 namespace {

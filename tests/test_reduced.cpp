@@ -2,7 +2,7 @@
 // discrete Euler-Lagrange scheme (32).  The RDLA of reduced.hpp, computed from L
 // and omega alone, must reproduce the full DLA projected to Q/G, and its
 // reconstructed group variables must reproduce the full ones, to round-off.
-#include "nhi/reduced.hpp"
+#include "nhi/methods/dla/reduced.hpp"
 
 #include "scenes.hpp"
 

@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "nhi/output.hpp"
-#include "nhi/scene.hpp"
-#include "nhi/scene_detail.hpp"
+#include "nhi/runner/output.hpp"
+#include "nhi/runner/scene.hpp"
+#include "nhi/runner/scene_detail.hpp"
 
 namespace {
 

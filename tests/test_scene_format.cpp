@@ -2,8 +2,8 @@
 // SceneError naming the key; a good scene resolves with its defaults.
 #include <gtest/gtest.h>
 
-#include "nhi/output.hpp"
-#include "nhi/scene.hpp"
+#include "nhi/runner/output.hpp"
+#include "nhi/runner/scene.hpp"
 
 namespace nhi {
 namespace {

@@ -11,8 +11,8 @@
 #include <cstdio>
 #include <fstream>
 
-#include "nhi/reference_body.hpp"
-#include "nhi/scene.hpp"
+#include "nhi/methods/reference/reference_body.hpp"
+#include "nhi/runner/scene.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {

@@ -10,8 +10,8 @@
 #include <cmath>
 #include <limits>
 
-#include "nhi/methods.hpp"
-#include "nhi/spark_body.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/methods/spark/spark_body.hpp"
 #include "scenes.hpp"
 
 namespace nhi::test {

@@ -1,8 +1,8 @@
 // Types that are not systems, given to a stepper: each must fail to compile
 // with the system concept's message for what it lacks (system.hpp,
 // check_system; tests/CMakeLists.txt compiles one case per test).
-#include "nhi/mp06.hpp"
-#include "nhi/rk4.hpp"
+#include "nhi/methods/explicit/rk4.hpp"
+#include "nhi/methods/mp06/mp06.hpp"
 
 namespace {
 

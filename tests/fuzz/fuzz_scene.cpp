@@ -14,7 +14,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "nhi/scene.hpp"
+#include "nhi/runner/scene.hpp"
 
 namespace {
 

@@ -18,7 +18,7 @@
 
 #include <array>
 
-#include "nhi/system.hpp"
+#include "nhi/roles/system.hpp"
 
 namespace nhi {
 

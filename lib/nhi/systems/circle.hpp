@@ -9,7 +9,7 @@
 //    omega and one holonomic constraint g = (|q|^2 - 1)/2.
 #pragma once
 
-#include "nhi/system.hpp"
+#include "nhi/roles/system.hpp"
 
 namespace nhi {
 

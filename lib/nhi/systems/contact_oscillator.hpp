@@ -28,7 +28,7 @@
 #include <utility>
 #include <vector>
 
-#include "nhi/system.hpp"
+#include "nhi/roles/system.hpp"
 
 namespace nhi {
 
@@ -79,7 +79,7 @@ struct ContactOscillator {
     return {fx + lambda, fy, fz + y * lambda};
   }
 
-  // The Poincare section family (experiments/study_poincare.cpp): `count` states
+  // The Poincare section family (experiments/studies/study_poincare.cpp): `count` states
   // on the default level H = 3/2, H_y = 1/2 at y's maximum (y0 = 1, yd0 = 0),
   // zd0 = xd0 = 0, z0 spread over [-0.9 sqrt 2, 0.9 sqrt 2] (|z0| < sqrt 2 for
   // R = 1), x0 = sqrt((2 - z0^2) / (1 + eps z0^2)) > 0.  The section plots

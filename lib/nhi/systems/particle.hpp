@@ -19,7 +19,7 @@
 
 #include <array>
 
-#include "nhi/system.hpp"
+#include "nhi/roles/system.hpp"
 
 namespace nhi {
 

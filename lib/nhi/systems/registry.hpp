@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "nhi/roles/typelist.hpp"
 #include "nhi/systems/chaotic_oscillator.hpp"
 #include "nhi/systems/contact_oscillator.hpp"
 #include "nhi/systems/contact_oscillator_nr.hpp"
@@ -17,7 +18,6 @@
 #include "nhi/systems/robot.hpp"
 #include "nhi/systems/rolling_disk.hpp"
 #include "nhi/systems/sleigh.hpp"
-#include "nhi/typelist.hpp"
 
 namespace nhi {
 

@@ -48,7 +48,7 @@
 #include <array>
 #include <cmath>
 
-#include "nhi/system.hpp"
+#include "nhi/roles/system.hpp"
 
 namespace nhi {
 

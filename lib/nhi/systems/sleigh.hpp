@@ -43,7 +43,7 @@
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <cmath>
 
-#include "nhi/system.hpp"
+#include "nhi/roles/system.hpp"
 
 namespace nhi {
 

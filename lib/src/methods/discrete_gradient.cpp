@@ -1,8 +1,8 @@
 // The discrete gradient (discrete_gradient.hpp), its stepper and runner glue, compiled
 // for every registered system: this method's translation unit (run.hpp).
-#include "nhi/discrete_gradient_body.hpp"
-#include "nhi/methods.hpp"
-#include "nhi/run_body.hpp"
+#include "nhi/methods/discrete_gradient/discrete_gradient_body.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/runner/run_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off

@@ -1,7 +1,7 @@
 // The DLA (dla.hpp, dla_composition.hpp): its runner glue (MethodRun), compiled
 // for every registered system: this method's translation unit (run.hpp).
-#include "nhi/methods.hpp"
-#include "nhi/run_body.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/runner/run_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off

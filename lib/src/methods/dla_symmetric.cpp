@@ -1,7 +1,7 @@
 // DlaStepper with L_d^{sym,alpha}, omega_d^{sym,alpha} (eqs. 10, 14), compiled
 // for every registered system: this method's translation unit (run.hpp).
-#include "nhi/dla_body.hpp"
-#include "nhi/run_body.hpp"
+#include "nhi/methods/dla/dla_body.hpp"
+#include "nhi/runner/run_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off

@@ -1,7 +1,7 @@
 // The adaptive pairs rkf78 and dopri5 (embedded_rk.hpp), compiled
 // for every registered system: this method's translation unit (run.hpp).
-#include "nhi/methods.hpp"
-#include "nhi/run_body.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/runner/run_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off

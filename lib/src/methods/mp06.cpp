@@ -1,8 +1,8 @@
 // mp06 (mp06.hpp), its steppers and runner glue, compiled
 // for every registered system: this method's translation unit (run.hpp).
-#include "nhi/methods.hpp"
-#include "nhi/mp06_body.hpp"
-#include "nhi/run_body.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/methods/mp06/mp06_body.hpp"
+#include "nhi/runner/run_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off

@@ -1,8 +1,8 @@
 // The CVODE reference (reference.hpp), its stepper and runner glue, compiled
 // for every registered system: this method's translation unit (run.hpp).
-#include "nhi/methods.hpp"
-#include "nhi/reference_body.hpp"
-#include "nhi/run_body.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/methods/reference/reference_body.hpp"
+#include "nhi/runner/run_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off

@@ -1,7 +1,7 @@
 // RK4 on the index-reduced equations (rk4.hpp), compiled
 // for every registered system: this method's translation unit (run.hpp).
-#include "nhi/methods.hpp"
-#include "nhi/run_body.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/runner/run_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off

@@ -1,9 +1,9 @@
 // SPARK (spark.hpp): its runner glue and its two-stage stepper, compiled for
 // every registered system (spark_3.cpp, spark_4.cpp: the other stage counts,
 // apart so that the cores compile them side by side).
-#include "nhi/methods.hpp"
-#include "nhi/run_body.hpp"
-#include "nhi/spark_body.hpp"
+#include "nhi/methods/methods.hpp"
+#include "nhi/methods/spark/spark_body.hpp"
+#include "nhi/runner/run_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 // clang-format off

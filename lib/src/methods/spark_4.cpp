@@ -1,5 +1,5 @@
 // SPARK's 4-stage stepper (spark.hpp), compiled for every registered system.
-#include "nhi/spark_body.hpp"
+#include "nhi/methods/spark/spark_body.hpp"
 #include "nhi/systems/registry.hpp"
 
 #define NHI_INSTANCES_(S) template class nhi::SparkStepper<nhi::S, 4>;
