@@ -3,7 +3,8 @@
 # the middle of a labelled method list is one new entry, not a difference in
 # every later row; a number changed in a later row is the one difference (exit
 # 1); the same tree against itself agrees (exit 0); an unlabelled array stays
-# positional (a longer one is structural).
+# positional (a longer one is structural); --ignore-key takes a shell pattern
+# (it skips every key it matches, and only those).
 set -uo pipefail
 compare=$1
 tmp=$(mktemp -d)
@@ -53,6 +54,23 @@ sed -i 's/"h": \[0.1, 0.05\]/"h": [0.1, 0.05, 0.025]/' "$tmp/new/study.json"
 out=$("$compare" "$tmp/old" "$tmp/new" 2>&1); rc=$?
 [ "$rc" -eq 1 ] || fail "a longer array of numbers: exit $rc, expected 1"
 grep -q '^    structural: scenes.particle.h: array length 2 -> 3$' <<< "$out" || fail "not structural: $out"
+
+# --ignore-key 'gc_*' (keys compare_results does not skip by itself): the keys it
+# matches moved and are no difference; an exact name matches only itself; a number
+# the pattern does not match still counts.
+cat > "$tmp/old/study.json" << 'EOF2'
+{"runs": [{"label": "rk4", "gc_first": 1.0, "gc_second": 2.0, "error": 1e-3}]}
+EOF2
+cat > "$tmp/new/study.json" << 'EOF2'
+{"runs": [{"label": "rk4", "gc_first": 1.5, "gc_second": 2.5, "error": 1e-3}]}
+EOF2
+out=$("$compare" "$tmp/old" "$tmp/new" --tol 0 --ignore-key 'gc_*' 2>&1); rc=$?
+[ "$rc" -eq 0 ] || fail "--ignore-key 'gc_*': exit $rc, expected 0 ($out)"
+out=$("$compare" "$tmp/old" "$tmp/new" --tol 0 --ignore-key gc_first 2>&1); rc=$?
+[ "$rc" -eq 1 ] || fail "--ignore-key gc_first: exit $rc, expected 1 (gc_second moved) ($out)"
+sed -i 's/"error": 1e-3}/"error": 2e-3}/' "$tmp/new/study.json"
+out=$("$compare" "$tmp/old" "$tmp/new" --tol 0 --ignore-key 'gc_*' 2>&1); rc=$?
+[ "$rc" -eq 1 ] || fail "--ignore-key 'gc_*' with a changed error: exit $rc, expected 1 ($out)"
 
 [ "$fails" -eq 0 ] && echo "ok"
 exit $fails
