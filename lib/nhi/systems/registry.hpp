@@ -11,6 +11,7 @@
 
 #include "nhi/roles/typelist.hpp"
 #include "nhi/systems/chaotic_oscillator.hpp"
+#include "nhi/systems/chaplygin_sphere.hpp"
 #include "nhi/systems/contact_oscillator.hpp"
 #include "nhi/systems/contact_oscillator_nr.hpp"
 #include "nhi/systems/magnetic_particle.hpp"
@@ -18,6 +19,7 @@
 #include "nhi/systems/robot.hpp"
 #include "nhi/systems/rolling_disk.hpp"
 #include "nhi/systems/sleigh.hpp"
+#include "nhi/systems/suslov.hpp"
 
 namespace nhi {
 
@@ -31,7 +33,9 @@ namespace nhi {
   X(ChaoticOscillator)            \
   X(Sleigh)                       \
   X(RollingDisk)                  \
-  X(MagneticParticle)
+  X(MagneticParticle)             \
+  X(Suslov)                       \
+  X(ChaplyginSphere)
 // clang-format on
 
 #define NHI_COMMA_THEN_(S) , S
