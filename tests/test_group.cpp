@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "nhi/methods/dla/dla_body.hpp"
-#include "nhi/methods/group/dla_group.hpp"
+#include "nhi/methods/group/dla_group_body.hpp"
 #include "nhi/systems/suslov.hpp"
 #include "scenes.hpp"
 

@@ -302,36 +302,9 @@ class GroupDlaStepper {
     h_ = h_prev_ = 0;
   }
 
-  StepSummary step(double h) {
-    VecG y;
-    if (steps_ == 0) {
-      const Mat<double, n, ng> E = C::template tangent<double>(q_curr_);
-      y = h * (E.transpose() * E).ldlt().solve(E.transpose() * v0_);
-    } else {
-      y = (h / h_) * y_;
-    }
-    VecL mu = steps_ == 0 ? VecL::Zero() : VecL(mu_);
-    if (steps_ > 0) {
-      q_prev_ = q_curr_;
-      q_curr_ = q_next_;
-      P_curr_ = P_next_;
-      y_prev_ = y_;
-    }
-    h_prev_ = h_;
-    h_ = h;
-    const Problem prob(sys_, alpha_, h, q_curr_, P_curr_);
-    StepSummary st = NewtonSolver<Problem>(prob, options_).solve(&y, &mu);
-    if (st.ok()) {
-      y_ = y;
-      mu_ = mu;
-      q_next_ = C::template retract<double>(q_curr_, y);
-      if constexpr (C::kGroup) q_next_.template segment<4>(C::qi).normalize();
-      P_next_ = group_slot<2, S, double>(sys_, alpha_, h, q_curr_, y);
-    }
-    ++steps_;
-    step_failed(&st, all_finite(q_next_) && all_finite(P_next_), "group DLA step ", steps_);
-    return st;
-  }
+  // One step: the solve of the trivialized eq. (6) from the extrapolation
+  // (dla_group_body.hpp, compiled for the registered systems in the library).
+  StepSummary step(double h);
 
   void sample(Sample<n, m>* s) const {
     s->q = q_curr_;
