@@ -24,11 +24,13 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 // An energy error below this fraction of |E0| is round-off (FateLevels::roundoff_relative).
 constexpr double kRoundOffEnergy = 1e-10;
 
-// Library methods with a fixed step (the reference solution is adaptive).
+// Library methods with a fixed step (the reference solution is adaptive)
+// studied on S (StudyMethod::on: the group DLA on the rigid bodies only).
+template <class S>
 std::vector<StudyMethod> fixed_step_methods() {
   std::vector<StudyMethod> out;
   for (const auto& m : study_methods())
-    if (m.fixed_step()) out.push_back(m);
+    if (m.fixed_step() && m.template on<S>()) out.push_back(m);
   return out;
 }
 
@@ -82,7 +84,7 @@ TYPED_TEST(MethodContract, FittedOrderIsTheDeclaredOrder) {
   Vec<double, S::n> qr, vr;
   random_state<S>(rng, &qr, &vr);
   const double T = 4.0;
-  for (const StudyMethod& m : fixed_step_methods()) {
+  for (const StudyMethod& m : fixed_step_methods<S>()) {
     const MethodTraits traits = method_traits(sys, m.spec);
     const int p = traits.order;
     const bool fit_energy = p <= 2 && !traits.preserves_energy;
@@ -189,7 +191,7 @@ TYPED_TEST(MethodContract, SymmetricMethodsAreReversibleAndOthersAreNot) {
   for (int trial = 0; trial < 3; ++trial) {
     Vec<double, n> q0, v0;
     random_state<S>(rng, &q0, &v0);
-    for (const StudyMethod& m : fixed_step_methods()) {
+    for (const StudyMethod& m : fixed_step_methods<S>()) {
       for (double h : {0.2, -0.2}) {
         {
           const auto st = make_stepper(sys, m.spec);
@@ -234,7 +236,7 @@ TYPED_TEST(MethodContract, SymmetricMethodsAreRhoReversibleExactlyOnReversibleSc
   for (int trial = 0; trial < 3; ++trial) {
     Vec<double, n> q0, v0;
     random_state<S>(rng, &q0, &v0);
-    for (const StudyMethod& m : fixed_step_methods()) {
+    for (const StudyMethod& m : fixed_step_methods<S>()) {
       const MethodTraits t = method_traits(sys, m.spec);
       const MapDefects d = map_defects(sys, m.spec, q0, v0, 0.2);
       ASSERT_TRUE(d.ok) << m.label();
@@ -285,7 +287,7 @@ TYPED_TEST(MethodContract, ReportedSamplesAndSolvesAreWhatTheMethodPromises) {
   const S sys = make_system<S>();
   const Vec<double, n> q0 = S::default_q0(), v0 = S::default_v0();
   const double h = 0.2;
-  for (const StudyMethod& sm : fixed_step_methods()) {
+  for (const StudyMethod& sm : fixed_step_methods<S>()) {
     std::vector<Sample<n, m>> samples;
     const RunReport rep = run_method(sys, sm.spec, q0, v0, h, 400, [&](const Sample<n, m>& s) {
       samples.push_back(s);
@@ -335,7 +337,7 @@ TYPED_TEST(MethodContract, AtModerateHEveryStepTakesTheRootContinuedFromZero) {
   const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
   const double h = 0.05;
   const long steps = 200;
-  for (const StudyMethod& sm : fixed_step_methods()) {
+  for (const StudyMethod& sm : fixed_step_methods<S>()) {
     if (!method_traits(sys, sm.spec).implicit) continue;
     MethodSpec checked = sm.spec, continued = sm.spec;
     checked.root_check = true;
@@ -388,7 +390,7 @@ TYPED_TEST(ReversibleSceneContract, SymmetricMethodsKeepTheEnergyBounded) {
   const Vec<double, S::n> q0 = S::default_q0(), v0 = S::default_v0();
   const double E0 = energy(sys, q0, v0);
   const long steps = 20000;
-  for (const StudyMethod& m : fixed_step_methods()) {
+  for (const StudyMethod& m : fixed_step_methods<S>()) {
     const MethodTraits t = method_traits(sys, m.spec);
     if (!t.symmetric || t.preserves_energy) continue;  // (energy-preserving: EnergyPreservingMethodsKeepItToRoundOff)
     double first = 0, last = 0;
@@ -421,7 +423,7 @@ TYPED_TEST(MethodContract, EnergyPreservingMethodsKeepItToRoundOff) {
   const double E0 = energy(sys, q0, v0);
   const long steps = 10000;
   int checked = 0;
-  for (const StudyMethod& m : fixed_step_methods()) {
+  for (const StudyMethod& m : fixed_step_methods<S>()) {
     if (!method_traits(sys, m.spec).preserves_energy || m.group != "main") continue;
     double worst = 0, scale = 0;
     const RunReport rep = run_method(sys, m.spec, q0, v0, 0.2, steps, [&](const Sample<S::n, S::m>& s) {
@@ -511,7 +513,7 @@ const std::map<std::string, std::vector<double>>& pinned() {
 TYPED_TEST(MethodContract, PinnedNumbers) {
   using S = TypeParam;
   const S sys = make_system<S>();
-  for (const StudyMethod& m : fixed_step_methods()) {
+  for (const StudyMethod& m : fixed_step_methods<S>()) {
     const Final<S> f = run_to_end(sys, m.spec, S::default_q0(), S::default_v0(), 0.2, 50);
     ASSERT_TRUE(f.rep.ok);
     const std::string key = std::string(S::name) + "/" + m.label();

@@ -250,7 +250,7 @@ void register_all(int shard, int nshards) {
     if (scene == "contact_oscillator_nr")
       benchmark::RegisterBenchmark("contact_oscillator_nr/mp06_hand_reduced_floor", BM_Mp06NrFloor);
     for (const nhi::StudyMethod& m : nhi::study_methods()) {
-      if (!m.fixed_step()) continue;  // every fixed-step method, variants too
+      if (!m.fixed_step() || !m.template on<S>()) continue;  // every fixed-step method studied on S, variants too
       std::string name = scene + "/" + m.label();
       std::replace(name.begin(), name.end(), ' ', '_');
       method_rows()[name] = {m.label(), m.spec.scene_keys()};

@@ -184,6 +184,26 @@ inline std::vector<nhi::StudyMethod> methods(const std::function<bool(const nhi:
     if (keep(m)) out.push_back(m);
   return out;
 }
+// The methods of `list` studied on the system S, in their order (StudyMethod::on:
+// the group DLA only on the systems with a quaternion).
+template <class S>
+inline std::vector<nhi::StudyMethod> on(const std::vector<nhi::StudyMethod>& list) {
+  std::vector<nhi::StudyMethod> out;
+  for (const auto& m : list)
+    if (m.template on<S>()) out.push_back(m);
+  return out;
+}
+// Is m studied on the system of `scene` (a validated scene)?  A study whose
+// cells span scenes runs a cell that is not as nothing: it returns
+// not_studied() (cost 0), and the study leaves that row out.
+inline bool studied_on_scene(const nhi::StudyMethod& m, const json& scene) {
+  return nhi::visit_scene(scene, [&](const auto& sys, const auto&, const auto&) {
+    return m.template on<std::decay_t<decltype(sys)>>();
+  });
+}
+inline json not_studied() { return json{{"not_studied", true}}; }
+inline bool is_not_studied(const json& row) { return row.is_object() && row.contains("not_studied"); }
+
 // Library methods with a fixed step (everything but the reference and the external ones).
 inline bool fixed_step(const nhi::StudyMethod& m) { return m.fixed_step(); }
 

@@ -66,7 +66,7 @@ std::vector<Variant> variants(const S& sys, const Vec<double, S::n>& q0, const V
                               const Vec<double, S::n>& qref) {
   std::vector<Variant> out;
   auto steps = [](double h) { return std::lround(kT / h); };
-  for (const nhi::StudyMethod& m : study::methods(study::fixed_step)) {
+  for (const nhi::StudyMethod& m : study::on<S>(study::methods(study::fixed_step))) {
     const nhi::MethodSpec spec = m.spec;
     const std::string family = spec.kind == "dla" ? spec.discretization : spec.kind;
     out.push_back({m.label(), family, spec.alpha,

@@ -314,8 +314,13 @@ int main(int argc, char** argv) {
   study::Options opt;
   std::string param;
   Grid g = parse_grid(argc, argv, &opt, &param);
-  g.methods = grid_methods(opt, g.roots);
   grid_scenes(opt, param, &g);
+  // The methods studied on every scene of the map (StudyMethod::on).
+  for (const nhi::StudyMethod& m : grid_methods(opt, g.roots)) {
+    bool on_all = true;
+    for (const std::string& name : g.scenes) on_all = on_all && study::studied_on_scene(m, study::scene(opt, name));
+    if (on_all) g.methods.push_back(m);
+  }
   const std::vector<json> runs = study::map_cells(opt, grid_cells(g, param));
 
   long total_steps = 0;

@@ -75,7 +75,7 @@ json reversibility_of(const json& scene) {
       return true;
     });
     json methods = json::array();
-    for (const nhi::StudyMethod& m : study::methods(study::fixed_step)) {
+    for (const nhi::StudyMethod& m : study::on<S>(study::methods(study::fixed_step))) {
       const nhi::MethodTraits t = nhi::method_traits(sys, m.spec);
       nhi::MapDefects worst;
       for (size_t i = 0; i < qs.size(); ++i) {

@@ -67,7 +67,7 @@ struct declares_integrable<S, std::enable_if_t<S::integrable>> : std::true_type 
 
 int main(int argc, char** argv) {
   const study::Options opt = study::parse(argc, argv, "Growth of the global error on the integrable scenes");
-  const std::vector<nhi::StudyMethod> methods =
+  const std::vector<nhi::StudyMethod> all_methods =
       study::methods([](const nhi::StudyMethod& m) { return m.fixed_step() && m.group == "main"; });
   const std::vector<long> ks = checkpoints(kSteps);
   json result = {{"study", "global_error"},
@@ -90,6 +90,7 @@ int main(int argc, char** argv) {
     const double h = kStepFraction * sc["h"].get<double>();
     const json scene_out = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
+      const std::vector<nhi::StudyMethod> methods = study::on<S>(all_methods);
       // The reference on the checkpoints.
       std::vector<Vec<double, S::n>> ref;
       std::string reference = "cvode 1e-13";

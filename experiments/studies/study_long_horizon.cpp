@@ -64,11 +64,13 @@ int main(int argc, char** argv) {
   // The longest runs first (map_cells orders them by this estimate).
   cells.cost = [&](size_t i) {
     const nhi::StudyMethod& m = methods[i % methods.size()];
+    if (!study::studied_on_scene(m, scene_json[i / methods.size()])) return 0.0;
     return steps_of(m) * study::step_weight(m.spec);
   };
   cells.name = [&](size_t i) { return scenes[i / methods.size()] + " " + methods[i % methods.size()].label(); };
   cells.run = [&](size_t i) {
     const nhi::StudyMethod& m = methods[i % methods.size()];
+    if (!study::studied_on_scene(m, scene_json[i / methods.size()])) return study::not_studied();
     return nhi::visit_scene(scene_json[i / methods.size()], [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
       const double h = scene_json[i / methods.size()]["h"].get<double>();
@@ -91,7 +93,8 @@ int main(int argc, char** argv) {
   const std::vector<json> runs = study::map_cells(opt, cells);
   for (size_t s = 0; s < scenes.size(); ++s) {
     json ms = json::array();
-    for (size_t k = 0; k < methods.size(); ++k) ms.push_back(runs[s * methods.size() + k]);
+    for (size_t k = 0; k < methods.size(); ++k)
+      if (!study::is_not_studied(runs[s * methods.size() + k])) ms.push_back(runs[s * methods.size() + k]);
     result["scenes"][scenes[s]] = {{"scene", scene_json[s]},
                                    {"h", scene_json[s]["h"]},
                                    {"T", scene_json[s]["h"].get<double>() * kSteps},

@@ -140,7 +140,7 @@ Section run_section(const S& sys, const nhi::MethodSpec& spec, const Vec<double,
 
 int main(int argc, char** argv) {
   const study::Options opt = study::parse(argc, argv, "Poincare sections of the contact oscillators");
-  const std::vector<nhi::StudyMethod> methods =
+  const std::vector<nhi::StudyMethod> all_methods =
       study::methods([](const nhi::StudyMethod& m) { return !m.external && m.group == "main"; });
   json result = {
       {"study", "poincare"},
@@ -160,6 +160,7 @@ int main(int argc, char** argv) {
     nhi::visit_scene(sc, [&](const auto& sys, const auto&, const auto&) {
       using S = std::decay_t<decltype(sys)>;
       if constexpr (nhi::has_section_states<S>::value) {
+        const std::vector<nhi::StudyMethod> methods = study::on<S>(all_methods);
         const auto states = sys.section_states(kStates);
         study::Cells cells;
         cells.label = "poincare " + name;

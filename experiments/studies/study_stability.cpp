@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
   for (size_t j = hs.size(); j-- > 0;)
     if (hs[j] >= roots_from * (1 - 1e-12)) first_root_h = j;
   const std::vector<double> root_hs(hs.begin() + first_root_h, hs.end());
-  const std::vector<nhi::StudyMethod> methods = study::methods(study::fixed_step);
+  const std::vector<nhi::StudyMethod> all_methods = study::methods(study::fixed_step);
   json result = {
       {"study", "stability"},
       {"config",
@@ -135,6 +135,7 @@ int main(int argc, char** argv) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
       using S = std::decay_t<decltype(sys)>;
+      const std::vector<nhi::StudyMethod> methods = study::on<S>(all_methods);
       const Vec<double, S::n> qref = study::reference_q(sys, q0, v0, T, 1e-12);
       std::vector<bool> implicit(methods.size());
       for (size_t m = 0; m < methods.size(); ++m) implicit[m] = nhi::method_traits(sys, methods[m].spec).implicit;

@@ -73,7 +73,11 @@ int main(int argc, char** argv) {
   study::Cells cells;
   cells.label = "states";
   cells.count = cases.size() * per_case;
-  cells.cost = [&](size_t i) { return double(steps) * study::step_weight(methods[(i % per_case) / kStates].spec); };
+  cells.cost = [&](size_t i) {
+    const nhi::StudyMethod& m = methods[(i % per_case) / kStates];
+    if (!study::studied_on_scene(m, cases[i / per_case].scene_json)) return 0.0;
+    return double(steps) * study::step_weight(m.spec);
+  };
   cells.name = [&](size_t i) {
     const Case& c = cases[i / per_case];
     char buf[96];
@@ -84,6 +88,7 @@ int main(int argc, char** argv) {
     const Case& c = cases[i / per_case];
     const nhi::StudyMethod& m = methods[(i % per_case) / kStates];
     const int state = static_cast<int>(i % kStates);
+    if (!study::studied_on_scene(m, c.scene_json)) return study::not_studied();
     return nhi::visit_scene(c.scene_json, [&](const auto& sys, const auto&, const auto&) -> json {
       using S = std::decay_t<decltype(sys)>;
       if constexpr (nhi::has_section_states<S>::value) {
@@ -131,6 +136,7 @@ int main(int argc, char** argv) {
     const Case& c = cases[ci];
     json ms = json::array();
     for (size_t mi = 0; mi < methods.size(); ++mi) {
+      if (study::is_not_studied(runs[ci * per_case + mi * kStates])) continue;
       json rs = json::array();
       int drifting = 0, failed = 0, roundoff = 0;
       std::vector<double> slopes, errors;

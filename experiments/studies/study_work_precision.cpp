@@ -377,11 +377,15 @@ json run_row(const S& sys, const Config& c, const Vec<double, S::n>& q0, const V
 
 int main(int argc, char** argv) {
   const study::Options opt = study::parse(argc, argv, "Work-precision: CPU time against accuracy, every scene");
-  const std::vector<Config> configs = all_configs();
+  const std::vector<Config> all = all_configs();
   json result = {{"study", "work_precision"}, {"config", study_config()}};
   for (const std::string& name : study::scene_names(opt)) {
     const json sc = study::scene(opt, name);
     result["scenes"][name] = nhi::visit_scene(sc, [&](const auto& sys, const auto& q0, const auto& v0) {
+      using S = std::decay_t<decltype(sys)>;
+      std::vector<Config> configs;  // the configurations of the methods studied on this scene
+      for (const Config& c : all)
+        if (c.method.template on<S>()) configs.push_back(c);
       const auto qref = study::reference_q(sys, q0, v0, kT_final, 1e-13);
       const bool long_scene = std::find(kLongScenes.begin(), kLongScenes.end(), name) != kLongScenes.end();
       study::Cells cells;

@@ -12,6 +12,7 @@
 #include "nhi/methods/dla/dla_composition.hpp"
 #include "nhi/methods/explicit/embedded_rk.hpp"
 #include "nhi/methods/explicit/rk4.hpp"
+#include "nhi/methods/group/dla_group_body.hpp"
 #include "nhi/methods/methods.hpp"
 #include "nhi/methods/mp06/mp06_body.hpp"
 #include "nhi/methods/reference/reference_body.hpp"

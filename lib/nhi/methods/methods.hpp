@@ -38,6 +38,7 @@
 #include "nhi/methods/dla/dla_composition.hpp"
 #include "nhi/methods/explicit/embedded_rk.hpp"
 #include "nhi/methods/explicit/rk4.hpp"
+#include "nhi/methods/group/dla_group.hpp"
 #include "nhi/methods/method_spec.hpp"
 #include "nhi/methods/mp06/mp06.hpp"
 #include "nhi/methods/reference/reference.hpp"
@@ -50,7 +51,7 @@ namespace nhi {
 
 // Every method the library has.
 using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod, Mp06Method, DiscreteGradientMethod, SparkMethod,
-                         Rkf78Method, Dopri5Method>;
+                         Rkf78Method, Dopri5Method, GroupDlaMethod>;
 
 inline std::vector<std::string> method_names() {
   std::vector<std::string> names;
@@ -69,6 +70,25 @@ void with_method_type(const std::string& kind, F&& f) {
     }
   });
   if (!found) throw std::invalid_argument("unknown method \"" + kind + "\"");
+}
+
+// Is the method of `spec` studied on the system S?  A method may declare
+//   template <class S> static constexpr bool studied_on();
+// (the group DLA: on the systems with a quaternion only; elsewhere it is the
+// alpha DLA, which the studies already run); without it, on every system.
+// The studies and the typed method tests run a method only where it is.
+template <class M, class S, class = void>
+struct declares_studied_on : std::false_type {};
+template <class M, class S>
+struct declares_studied_on<M, S, std::void_t<decltype(M::template studied_on<S>())>> : std::true_type {};
+template <class S>
+inline bool studied_on(const MethodSpec& spec) {
+  bool out = true;
+  with_method_type(spec.kind, [&](auto tag) {
+    using M = typename decltype(tag)::type;
+    if constexpr (declares_studied_on<M, S>::value) out = M::template studied_on<S>();
+  });
+  return out;
 }
 
 // The method's declared flags and keys, by name.
@@ -162,6 +182,11 @@ struct StudyMethod {
   bool adaptive() const { return method_flags(spec.kind).adaptive; }
   // A method with a fixed step (not the adaptive reference, not the pairs).
   bool fixed_step() const { return !adaptive(); }
+  // Is it studied on the system S (studied_on above)?
+  template <class S>
+  bool on() const {
+    return studied_on<S>(spec);
+  }
 };
 
 inline const std::vector<StudyMethod>& study_methods() {

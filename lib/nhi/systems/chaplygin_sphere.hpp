@@ -50,7 +50,7 @@
 #include <Eigen/LU>
 
 #include "nhi/roles/system.hpp"
-#include "nhi/systems/quaternion.hpp"
+#include "nhi/groups/quaternion.hpp"
 
 namespace nhi {
 
@@ -62,6 +62,10 @@ struct ChaplyginSphere {
   static constexpr bool reversible = true;
   // Chaplygin's integrable case of the rolling ball (see above).
   static constexpr bool integrable = true;
+  // The orientation is q[2..5] (a unit quaternion) and row 0 of omega is
+  // p . pdot = 0 (methods/group/ step on the group instead).
+  static constexpr int orientation = 2;
+  static constexpr int norm_row = 0;
 
   double mass = 1.0;  // m
   double r = 1.0;     // radius

@@ -63,7 +63,7 @@
 #include <cmath>
 
 #include "nhi/roles/system.hpp"
-#include "nhi/systems/quaternion.hpp"
+#include "nhi/groups/quaternion.hpp"
 
 namespace nhi {
 
@@ -75,6 +75,10 @@ struct Suslov {
   static constexpr bool reversible = true;
   // With a a principal axis (the default) Omega is constant: integrable.
   static constexpr bool integrable = true;
+  // The orientation is q itself (a unit quaternion, coordinates 0..3) and row 0
+  // of omega is p . pdot = 0 (methods/group/ step on the group instead).
+  static constexpr int orientation = 0;
+  static constexpr int norm_row = 0;
 
   double I1 = 1.0, I2 = 10.0, I3 = 100.0;  // body inertia diag(I1, I2, I3)
   double a1 = 0.0, a2 = 0.0, a3 = 1.0;     // <a, Omega> = 0

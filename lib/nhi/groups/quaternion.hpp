@@ -141,4 +141,76 @@ inline Vec<double, 4> half_exp(const Vec<double, 3>& v) {
   return r;
 }
 
+// --- The group's own maps, generic in the scalar (the methods on the group,
+// methods/group/): the product, the conjugate, exp of a rotation vector and its
+// inverse log, and the tangent map of right translation.  exp and log switch to
+// their Taylor series near zero, where sqrt has no derivative; the series are
+// cut where the next term is below 1e-20 relative.
+
+// a b.
+template <class T>
+Vec<T, 4> mul(const Vec<T, 4>& a, const Vec<T, 4>& b) {
+  Vec<T, 4> r;
+  r[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
+  r[1] = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
+  r[2] = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
+  r[3] = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
+  return r;
+}
+
+// a-bar.
+template <class T>
+Vec<T, 4> conj(const Vec<T, 4>& a) {
+  return Vec<T, 4>(a[0], -a[1], -a[2], -a[3]);
+}
+
+// exp(xi) = (cos(|xi|/2), sin(|xi|/2) xi/|xi|): the rotation by |xi| about xi
+// (half_exp() for any scalar).
+template <class T>
+Vec<T, 4> exp_map(const Vec<T, 3>& xi) {
+  const T s = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2];
+  T c, k;  // cos(|xi|/2), sin(|xi|/2)/|xi|
+  if (value_of(s) < 1e-4) {
+    c = cst<T>(1.0) - s * cst<T>(1.0 / 8) + s * s * cst<T>(1.0 / 384) - s * s * s * cst<T>(1.0 / 46080) +
+        s * s * s * s * cst<T>(1.0 / 10321920);
+    k = cst<T>(0.5) - s * cst<T>(1.0 / 48) + s * s * cst<T>(1.0 / 3840) - s * s * s * cst<T>(1.0 / 645120) +
+        s * s * s * s * cst<T>(1.0 / 185794560);
+  } else {
+    using std::cos;
+    using std::sin;
+    using std::sqrt;
+    const T th = sqrt(s);
+    c = cos(th * cst<T>(0.5));
+    k = sin(th * cst<T>(0.5)) / th;
+  }
+  return Vec<T, 4>(c, k * xi[0], k * xi[1], k * xi[2]);
+}
+
+// log(p) for a unit quaternion: the rotation vector of length <= pi (p and -p
+// are one rotation).
+template <class T>
+Vec<T, 3> log_map(const Vec<T, 4>& p0) {
+  const Vec<T, 4> p = value_of(p0[0]) < 0 ? Vec<T, 4>(-p0) : p0;
+  const T r = p[1] * p[1] + p[2] * p[2] + p[3] * p[3];  // sin^2(|xi|/2)
+  T k;                                                  // 2 atan2(sqrt r, w) / sqrt r
+  if (value_of(r) < 1e-4 && value_of(p[0]) > 0.5) {
+    const T t = r / (p[0] * p[0]);  // atan(x)/x = 1 - x^2/3 + x^4/5 - ..., x^2 = t
+    k = cst<T>(2.0) / p[0] *
+        (cst<T>(1.0) - t * cst<T>(1.0 / 3) + t * t * cst<T>(1.0 / 5) - t * t * t * cst<T>(1.0 / 7) +
+         t * t * t * t * cst<T>(1.0 / 9) - t * t * t * t * t * cst<T>(1.0 / 11));
+  } else {
+    using std::atan2;
+    using std::sqrt;
+    const T sr = sqrt(r);
+    k = cst<T>(2.0) * atan2(sr, p[0]) / sr;
+  }
+  return Vec<T, 3>(k * p[1], k * p[2], k * p[3]);
+}
+
+// d/de p exp(e eta) at e = 0 = p (0, eta) / 2 = G(p)^T eta / 2: a 4 x 3 matrix.
+template <class T>
+Mat<T, 4, 3> tangent(const Vec<T, 4>& p) {
+  return cst<T>(0.5) * matrix(p).transpose();
+}
+
 }  // namespace nhi::quaternion
