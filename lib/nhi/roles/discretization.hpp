@@ -151,6 +151,19 @@ inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& d
           (*scale)[a] += nd.weight * std::abs(value_of(W(a, j))) * std::abs(value_of(v[j]));
     }
   }
+  // A unit quaternion's norm row p^T pdot = 0 is the velocity form of the
+  // holonomic g(q) = (|p|^2 - 1)/2 = 0: it is held as g(q_{k+1}) = 0 (eq. 17,
+  // second line; divided by h to keep the row's scale).  The alpha rule's own
+  // row, p_alpha^T (p1 - p0)/h, gives |p1|^2 - |p0|^2 = (1 - 2 alpha)|p1 - p0|^2:
+  // off the midpoint it moves |p| every step and, for alpha > 1/2, drives the
+  // solve to failure.  At alpha = 1/2 the two agree while |p0| = 1.
+  constexpr int qi = quaternion_at<S>::value, nr = norm_row_of<S>::value;
+  if constexpr (qi >= 0 && nr >= 0) {
+    T s2 = q1[qi] * q1[qi];
+    for (int i = 1; i < 4; ++i) s2 += q1[qi + i] * q1[qi + i];
+    w[nr] = divide(T(s2 - cst<T>(1.0)), 2 * h);
+    if (scale) (*scale)[nr] = (value_of(s2) + 1.0) / (2 * std::abs(h));
+  }
   return w;
 }
 

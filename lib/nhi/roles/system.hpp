@@ -224,6 +224,20 @@ struct holonomic_count : std::integral_constant<int, 0> {};
 template <class S>
 struct holonomic_count<S, std::void_t<decltype(S::l)>> : std::integral_constant<int, S::l> {};
 
+// A rigid body's orientation as a unit quaternion p in q (systems/suslov.hpp,
+// chaplygin_sphere.hpp): where its four coordinates start (-1: none), and which
+// omega row is p^T pdot = 0, the velocity form of |p|^2 = 1 (-1: none).  The DLA
+// holds that row holonomically (eq. 17; roles/discretization.hpp), the methods
+// on the group (methods/group/) drop it.
+template <class S, class = void>
+struct quaternion_at : std::integral_constant<int, -1> {};
+template <class S>
+struct quaternion_at<S, std::void_t<decltype(S::orientation)>> : std::integral_constant<int, S::orientation> {};
+template <class S, class = void>
+struct norm_row_of : std::integral_constant<int, -1> {};
+template <class S>
+struct norm_row_of<S, std::void_t<decltype(S::norm_row)>> : std::integral_constant<int, S::norm_row> {};
+
 // g(q) and its derivative Dg(q) (an l x n matrix) by one Jet.
 template <class S>
 inline Mat<double, holonomic_count<S>::value, S::n> holonomic_jacobian(const S& sys, const Vec<double, S::n>& q) {

@@ -40,17 +40,6 @@
 
 namespace nhi {
 
-// The chart structure of a system: where its unit quaternion sits (-1: none)
-// and which omega row is p^T pdot = 0 (-1: none).
-template <class S, class = void>
-struct quaternion_at : std::integral_constant<int, -1> {};
-template <class S>
-struct quaternion_at<S, std::void_t<decltype(S::orientation)>> : std::integral_constant<int, S::orientation> {};
-template <class S, class = void>
-struct norm_row_of : std::integral_constant<int, -1> {};
-template <class S>
-struct norm_row_of<S, std::void_t<decltype(S::norm_row)>> : std::integral_constant<int, S::norm_row> {};
-
 // A x, entry by entry (for a Jet of Jets, see GroupChart::tangent).
 template <class T, int r, int c>
 inline Vec<T, r> times(const Mat<T, r, c>& A, const Vec<T, c>& x) {
