@@ -68,6 +68,17 @@ struct LinearlyEmbedded {
     }
     return out;
   }
+  // A quaternion's norm row (the rigid bodies) stays the row it is, and the
+  // DLA holds it as the level set of |p|^2 / 2 (system.hpp) in either coordinates.
+  static constexpr int norm_row = norm_row_of<S>::value;
+  template <class T>
+  T norm_invariant(const Vec<T, n>& v) const {
+    constexpr int qi = quaternion_at<S>::value;
+    const Vec<T, S::n> q = chart_of(v, true);
+    T g = cst<T>(0.0);
+    for (int i = qi; i < qi + 4; ++i) g += q[i] * q[i];
+    return cst<T>(0.5) * g;
+  }
   template <class T>
   Vec<T, 1> g(const Vec<T, n>& v) const {
     return Vec<T, 1>(normal_part(v, chart_of(v, true)) - cst<T>(c0));

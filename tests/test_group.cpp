@@ -8,6 +8,7 @@
 
 #include "nhi/methods/dla/dla_body.hpp"
 #include "nhi/methods/group/dla_group_body.hpp"
+#include "nhi/runner/scene.hpp"
 #include "nhi/systems/suslov.hpp"
 #include "scenes.hpp"
 
@@ -60,17 +61,23 @@ Vec<double, 4> suslov_q0() { return Suslov::default_q0(); }
 Vec<double, 4> suslov_v0() { return Suslov::default_v0(); }
 
 // On the Suslov problem with a principal axis the motion is a steady rotation
-// (suslov.hpp): the midpoint group DLA converges to it with order 2.
+// (suslov.hpp; experiments/scenes/suslov_steady.json): the midpoint group DLA
+// converges to it with order 2.
 TEST(GroupDla, SuslovSteadyRotationAtOrderTwo) {
-  const Suslov sys;
+  const json sc = validate_scene(load_scene_file(std::string(NHI_SCENES) + "/suslov_steady.json"));
+  Suslov sys;
+  sys.a1 = sc["params"]["a1"], sys.a2 = sc["params"]["a2"], sys.a3 = sc["params"]["a3"];
+  ASSERT_TRUE(sys.principal_axis());
+  Vec<double, 4> q0, v0;
+  for (int i = 0; i < 4; ++i) q0[i] = sc["q0"][i], v0[i] = sc["v0"][i];
   const double T = 4;
   std::vector<double> hs, errs;
   for (double h : {0.1, 0.05, 0.025, 0.0125}) {
     GroupDlaStepper<Suslov> st(sys, 0.5);
     const long steps = std::lround(T / h);
-    const auto s = run_samples<GroupDlaStepper<Suslov>, 4, 2>(st, suslov_q0(), suslov_v0(), h, steps);
+    const auto s = run_samples<GroupDlaStepper<Suslov>, 4, 2>(st, q0, v0, h, steps);
     Vec<double, 4> q, v;
-    ASSERT_TRUE(sys.exact_solution(suslov_q0(), suslov_v0(), s.back().t, &q, &v));
+    ASSERT_TRUE(sys.exact_solution(q0, v0, s.back().t, &q, &v));
     hs.push_back(h);
     errs.push_back((s.back().q - q).norm());
   }

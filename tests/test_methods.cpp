@@ -480,7 +480,17 @@ TYPED_TEST(MethodContract, DiscretizationsAreTheirFormulas) {
     }
     const Vec<double, n> v = (q1 - q0) / h;
     auto L = [&](double c) { return sys.template lagrangian<double>((1 - c) * q0 + c * q1, v); };
-    auto W = [&](double c) { return Vec<double, S::m>(sys.template omega<double>((1 - c) * q0 + c * q1) * v); };
+    // A quaternion's norm row is held as the increment of |p|^2 / 2 over the
+    // step, divided by h, at every alpha (roles/discretization.hpp).
+    auto W = [&](double c) {
+      Vec<double, S::m> w = sys.template omega<double>((1 - c) * q0 + c * q1) * v;
+      if constexpr (norm_row_of<S>::value >= 0) {
+        constexpr int qi = quaternion_at<S>::value;
+        const Vec<double, 4> p0 = q0.template segment<4>(qi), p1 = q1.template segment<4>(qi);
+        w[norm_row_of<S>::value] = 0.5 * (p1.squaredNorm() - p0.squaredNorm()) / h;
+      }
+      return w;
+    };
     for (double a : {0.0, 0.25, 0.5, 0.8, 1.0}) {
       const double tol = 1e-14 * (1 + std::abs(h * L(a)));
       EXPECT_NEAR(discrete_lagrangian<S>(sys, AlphaDiscretization{a}, h, q0, q1), h * L(a), tol);  // eq. 9

@@ -202,7 +202,7 @@ TEST(Suslov, SteadyRotationIsTheReferenceSolution) {
   EXPECT_FALSE(tilted.exact_solution(Suslov::default_q0(), Suslov::default_v0(), 1.0, &q, &v));
 }
 
-// The scene with a not a principal axis (experiments/scenes/suslov_fz.json):
+// The scene with a not a principal axis (experiments/scenes/suslov.json):
 // a = (0, alpha, beta) in the plane of e2 and e3, so with b = (0, beta, -alpha)
 // and Omega = u e1 + w b the reduced equations are the Chaplygin sleigh's,
 //   I1 u' = k w^2,  J w' = -k u w,  k = alpha beta (I3 - I2),  J = beta^2 I2 + alpha^2 I3,
@@ -210,7 +210,7 @@ TEST(Suslov, SteadyRotationIsTheReferenceSolution) {
 // kappa = k c / J, w* = c sqrt(I1 / J): the body turns over from the steady
 // rotation -c e1 to +c e1 at constant energy.  Against the reference solution.
 TEST(Suslov, FedorovZenkovSceneTurnsOverAtConstantEnergy) {
-  const json sc = validate_scene(load_scene_file(std::string(NHI_SCENES) + "/suslov_fz.json"));
+  const json sc = validate_scene(load_scene_file(std::string(NHI_SCENES) + "/suslov.json"));
   Suslov sys;
   sys.I1 = sc["params"]["I1"], sys.I2 = sc["params"]["I2"], sys.I3 = sc["params"]["I3"];
   sys.a1 = sc["params"]["a1"], sys.a2 = sc["params"]["a2"], sys.a3 = sc["params"]["a3"];
@@ -285,14 +285,14 @@ TEST(ChaplyginSphere, FirstIntegralsAreConstantAlongTheReferenceSolution) {
   EXPECT_GT(moved, 1.0);  // the motion is not trivial
 }
 
-// The midpoint rule's discrete constraint for the row p^T (eq. 13, alpha = 1/2)
-// is p_mid . (p1 - p0) / h = (|p1|^2 - |p0|^2) / 2h = 0: the DLA keeps |p| to
-// round-off, and so does the symmetric rule with alpha = 0 ((W(0) + W(1)) / 2,
-// the same row); alpha = 1/4 does not (there |p1|^2 - |p0|^2 = (1 - 2 alpha) |p1 - p0|^2).
-// Each step solves its discrete constraint to round-off of its terms, |p| / h
-// (MethodContract's 64 eps), so |p1|^2 - |p0|^2 = 2 h omega_d is at most
-// 128 eps |p|^2 a step, and the bound over N steps is N 128 eps (measured: about
-// 7 eps a step for the Suslov midpoint run, far less for the others).
+// The norm row p^T pdot = 0 is held as the increment of g = |p|^2 / 2,
+// (p0 + p1) . (p1 - p0) / 2h = 0 (roles/discretization.hpp, eq. 17), at every
+// alpha: every DLA rule keeps |p| to round-off.  The alpha rule's own row,
+// p_alpha . (p1 - p0) / h, would not: it is (|p1|^2 - |p0|^2 - (1 - 2 alpha)
+// |p1 - p0|^2) / 2h (checked below on random pairs), which off the midpoint
+// moves |p| by O(h^2) a step.  Each step solves its discrete constraint to
+// round-off of its terms (MethodContract's 64 eps), so |p1|^2 - |p0|^2 is at
+// most 128 eps |p|^2 a step, and the bound over N steps is N 128 eps.
 template <class S, class D>
 double norm_drift(const D& disc, double h, long steps) {
   const S sys;
@@ -308,20 +308,32 @@ double norm_drift(const D& disc, double h, long steps) {
 }
 
 template <class S>
-void expect_norm_held_by_the_midpoint_rules() {
-  const double mid = norm_drift<S>(AlphaDiscretization{0.5}, 0.05, 2000);
-  const double sym = norm_drift<S>(SymmetricDiscretization{0.0}, 0.05, 2000);
-  const double off = norm_drift<S>(AlphaDiscretization{0.25}, 0.05, 2000);
-  std::printf("    %s, h = 0.05, T = 100: max ||p|^2 - 1| midpoint %.2g, symmetric alpha = 0 %.2g, alpha = 1/4 %.2g\n",
-              S::name, mid, sym, off);
+void expect_norm_held_by_every_rule() {
   const double bound = 2000 * 128 * std::numeric_limits<double>::epsilon();
-  EXPECT_LT(mid, bound);
+  std::printf("    %s, h = 0.05, T = 100: max ||p|^2 - 1|", S::name);
+  for (double a : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    const double d = norm_drift<S>(AlphaDiscretization{a}, 0.05, 2000);
+    std::printf(", alpha %g %.2g", a, d);
+    EXPECT_LT(d, bound) << "alpha " << a;
+  }
+  const double sym = norm_drift<S>(SymmetricDiscretization{0.0}, 0.05, 2000);
+  std::printf(", symmetric alpha = 0 %.2g\n", sym);
   EXPECT_LT(sym, bound);
-  EXPECT_GT(off, 1e-3);
+  // The alpha rule's own row (what the norm row replaces), on random pairs.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    Vec4 p0, p1;
+    for (int i = 0; i < 4; ++i) p0[i] = u(rng), p1[i] = u(rng);
+    const double a = 0.5 * (1 + u(rng));
+    const Vec4 pa = (1 - a) * p0 + a * p1;
+    const double row = pa.dot(p1 - p0), identity = 0.5 * (p1.squaredNorm() - p0.squaredNorm() - (1 - 2 * a) * (p1 - p0).squaredNorm());
+    EXPECT_NEAR(row, identity, 1e-14);
+  }
 }
 
-TEST(Suslov, MidpointDlaHoldsTheNorm) { expect_norm_held_by_the_midpoint_rules<Suslov>(); }
-TEST(ChaplyginSphere, MidpointDlaHoldsTheNorm) { expect_norm_held_by_the_midpoint_rules<ChaplyginSphere>(); }
+TEST(Suslov, EveryDlaRuleHoldsTheNorm) { expect_norm_held_by_every_rule<Suslov>(); }
+TEST(ChaplyginSphere, EveryDlaRuleHoldsTheNorm) { expect_norm_held_by_every_rule<ChaplyginSphere>(); }
 
 }  // namespace
 }  // namespace nhi::test

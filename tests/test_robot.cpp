@@ -65,7 +65,7 @@ TEST(Robot, DlaFastPathIsTheExactStepToRoundOff) {
       discrete_lagrangian_slots<S, D, long double>(sys, disc, (long double)h, q0, q1, &D1, nullptr);
       Vec<long double, n + mc> r;
       r.template head<n>() = p.cast<long double>() + D1 - prob.Wt().cast<long double>() * l;
-      r.template tail<mc>() = discrete_constraint_with<S, D, long double>(om, disc, (long double)h, q0, q1, nullptr);
+      r.template tail<mc>() = discrete_constraint_with<S, D, long double>(sys, om, disc, (long double)h, q0, q1, nullptr);
       using J = ceres::Jet<double, n>;
       Vec<J, n> yj;
       for (int i = 0; i < n; ++i) yj[i] = J(double(q1[i]), i);

@@ -219,7 +219,7 @@ def paper_dla: startswith("dla");
 # order.  The classes come in this order, any other after them; a scene the
 # runner does not know is a class of its own.
 CLASS_ORDER='["reversible, integrable", "reversible, chaotic", "reversible flow, non-reversible maps",
-              "not reversible", "reversible, attracted to a line"]'
+              "not reversible", "reversible, attracted to a line", "rigid body"]'
 CLASSES=$("$NHI" list --json | jq -c --argjson order "$CLASS_ORDER" '
   [.systems[] | {class, scene: .name}] as $sys |
   reduce ($order[], $sys[].class) as $c ([]; if index($c) then . else . + [$c] end) |

@@ -134,8 +134,9 @@ inline Vec<T, S::n> discrete_lagrangian_slot(const S& sys, const D& disc, double
 // omega_at(k, q_c) gives omega(q_c) at the k-th constraint node (a caller
 // may have it at hand: DlaStepper's passes).
 template <class S, class D, class T, class OmegaAt>
-inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& disc, double h, const Vec<T, S::n>& q0,
-                                             const Vec<T, S::n>& q1, Vec<double, S::m>* scale = nullptr) {
+inline Vec<T, S::m> discrete_constraint_with(const S& sys, const OmegaAt& omega_at, const D& disc, double h,
+                                             const Vec<T, S::n>& q0, const Vec<T, S::n>& q1,
+                                             Vec<double, S::m>* scale = nullptr) {
   Vec<T, S::n> v;
   for (int i = 0; i < S::n; ++i) v[i] = divide(T(q1[i] - q0[i]), h);
   Vec<T, S::m> w;
@@ -152,17 +153,18 @@ inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& d
     }
   }
   // A unit quaternion's norm row p^T pdot = 0 is the velocity form of the
-  // holonomic g(q) = (|p|^2 - 1)/2 = 0: it is held as g(q_{k+1}) = 0 (eq. 17,
-  // second line; divided by h to keep the row's scale).  The alpha rule's own
-  // row, p_alpha^T (p1 - p0)/h, gives |p1|^2 - |p0|^2 = (1 - 2 alpha)|p1 - p0|^2:
-  // off the midpoint it moves |p| every step and, for alpha > 1/2, drives the
-  // solve to failure.  At alpha = 1/2 the two agree while |p0| = 1.
-  constexpr int qi = quaternion_at<S>::value, nr = norm_row_of<S>::value;
-  if constexpr (qi >= 0 && nr >= 0) {
-    T s2 = q1[qi] * q1[qi];
-    for (int i = 1; i < 4; ++i) s2 += q1[qi + i] * q1[qi + i];
-    w[nr] = divide(T(s2 - cst<T>(1.0)), 2 * h);
-    if (scale) (*scale)[nr] = (value_of(s2) + 1.0) / (2 * std::abs(h));
+  // holonomic g(q) = |p|^2 / 2 (norm_increment, system.hpp): it is held as
+  // g(q_{k+1}) = g(q_k) (eq. 17 on the level set of g through q_0; divided by h,
+  // the row's scale), for the quaternion the midpoint's row (p0 + p1)^T (p1 - p0) / 2h
+  // at every alpha.  The alpha rule's own row, p_alpha^T (p1 - p0) / h, gives
+  // |p1|^2 - |p0|^2 = (1 - 2 alpha)|p1 - p0|^2: off the midpoint it moves |p|
+  // every step and, for alpha > 1/2, drives the solve to failure (the Suslov
+  // problem at h = 0.2: at step 46 for alpha = 0.75).
+  constexpr int nr = norm_row_of<S>::value;
+  if constexpr (nr >= 0) {
+    double s = 0;
+    w[nr] = divide(norm_increment<S, T>(sys, q0, q1, &s), h);
+    if (scale) (*scale)[nr] = s / std::abs(h);
   }
   return w;
 }
@@ -170,8 +172,8 @@ inline Vec<T, S::m> discrete_constraint_with(const OmegaAt& omega_at, const D& d
 template <class S, class D, class T>
 inline Vec<T, S::m> discrete_constraint(const S& sys, const D& disc, double h, const Vec<T, S::n>& q0,
                                         const Vec<T, S::n>& q1, Vec<double, S::m>* scale = nullptr) {
-  return discrete_constraint_with<S, D, T>([&](int, const Vec<T, S::n>& q) { return sys.template omega<T>(q); }, disc,
-                                           h, q0, q1, scale);
+  return discrete_constraint_with<S, D, T>(
+      sys, [&](int, const Vec<T, S::n>& q) { return sys.template omega<T>(q); }, disc, h, q0, q1, scale);
 }
 
 }  // namespace nhi

@@ -35,7 +35,9 @@
 //   nonholonomic_momentum, momentum_equation_rhs   // a symmetry for eq. (24)
 //   reduced_flow                               // an independent exact reduced description
 //   paper_section                              // one of the paper's scenes (section 6.x)
-// reversible, integrable, reversible_flow and behaviour make a scene's "class" in
+//   orientation, norm_row                      // a rigid body: q holds a unit quaternion
+//                                              // (quaternion_at, norm_row_of below)
+// reversible, integrable, reversible_flow and behaviour (orientation: "rigid body") make a scene's "class" in
 // `nhi list --json` (catalog() in lib/src/runner/scene.cpp), by which experiments/tools/summarize.sh
 // groups the scenes of its decision table.
 // The pair (l, g) adds l holonomic constraints g(q) = 0: the Constrained Coordinate
@@ -237,6 +239,39 @@ template <class S, class = void>
 struct norm_row_of : std::integral_constant<int, -1> {};
 template <class S>
 struct norm_row_of<S, std::void_t<decltype(S::norm_row)>> : std::integral_constant<int, S::norm_row> {};
+
+// The function g whose level set the norm row's discrete form holds (the DLA:
+// g(q_{k+1}) = g(q_k), roles/discretization.hpp): the system's own
+// norm_invariant(q) if it has one (a system in other coordinates, as
+// tests/test_embedding.cpp's), else |p|^2 / 2 of its quaternion.
+template <class S, class T, class = void>
+struct has_norm_invariant : std::false_type {};
+template <class S, class T>
+struct has_norm_invariant<S, T,
+                          std::void_t<decltype(std::declval<const S&>().template norm_invariant<T>(
+                              std::declval<const Vec<T, S::n>&>()))>> : std::true_type {};
+// g(q1) - g(q0) for that g, and in *scale the size of the terms its round-off
+// is judged against: for the quaternion, (p1 - p0) . (p1 + p0) / 2, accurate to
+// eps |p1 - p0| |p1 + p0| where the difference of |p|^2 would lose eps |p|^2.
+template <class S, class T>
+inline T norm_increment(const S& sys, const Vec<T, S::n>& q0, const Vec<T, S::n>& q1, double* scale) {
+  if constexpr (has_norm_invariant<S, T>::value) {
+    const T g1 = sys.template norm_invariant<T>(q1), g0 = sys.template norm_invariant<T>(q0);
+    *scale = std::abs(value_of(g1)) + std::abs(value_of(g0));
+    return g1 - g0;
+  } else {
+    constexpr int qi = quaternion_at<S>::value;
+    static_assert(qi >= 0, "a norm row needs a quaternion or the system's norm_invariant()");
+    T d = cst<T>(0.0);
+    *scale = 0;
+    for (int i = qi; i < qi + 4; ++i) {
+      d += (q1[i] - q0[i]) * (q1[i] + q0[i]);
+      *scale += std::abs(value_of(q1[i] - q0[i])) * std::abs(value_of(q1[i] + q0[i]));
+    }
+    *scale *= 0.5;
+    return cst<T>(0.5) * d;
+  }
+}
 
 // g(q) and its derivative Dg(q) (an l x n matrix) by one Jet.
 template <class S>

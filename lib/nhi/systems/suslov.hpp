@@ -39,24 +39,25 @@
 //   R(t) = R0 exp(t Omega0^),  p(t) = p0 (cos(th/2), sin(th/2) Omega0/|Omega0|), th = |Omega0| t,
 // pdot(t) = p(t) (0, Omega0) / 2; for |p0| = s != 1 the same with Omega0 =
 // 2 G(p0) pdot0 / s^2 (|p| = s is kept).  States on the constraints (as motions are).
-// Elsewhere none (false).  Reversible (L even in v); integrable where a is a
-// principal axis (Omega is constant), as in the default scene.
+// Elsewhere none (false).  Reversible (L even in v).
 //
-// Default run (experiments/scenes/suslov.json): I = diag(1, 10, 100), a = e3,
-// Pi0 = I Omega0 = (1, 1, 0) (Omega0 = (1, 0.1, 0)), a generic orientation
-// p0 = (0.9, 0.3, 0.3, 0.1) (|p0| = 1; the identity would leave z = 0 for ever,
-// a coordinate of rounding noise only), pdot0 = p0 (0, Omega0) / 2 =
-// (-0.165, 0.445, 0.095, -0.135), h = 0.01, 1800 steps (T = 18): a steady
-// rotation at |Omega0| = 1.005, 2.9 turns, E = 0.55.
-// experiments/scenes/suslov_fz.json: the same body and p0 with a = (0, 0.6, 0.8),
-// not a principal axis, as in Fedorov & Zenkov's example (their numbers were
-// not found; these are this project's choice).  There Omega = u e1 + w b,
+// Default run (experiments/scenes/suslov.json): I = diag(1, 10, 100) and
+// a = (0, 0.6, 0.8), not a principal axis, as in Fedorov & Zenkov's example
+// (their numbers were not found; these are this project's choice), with a
+// generic orientation p0 = (0.9, 0.3, 0.3, 0.1) (|p0| = 1).  There Omega = u e1 + w b,
 // b = (0, 0.8, -0.6), and the reduced equations are
 //   I1 u' = k w^2,  J w' = -k u w,   k = 0.48 (I3 - I2) = 43.2,  J = b^T I b = 42.4,
 // the Chaplygin sleigh's (sleigh.hpp): u = c tanh(kappa (t - t*)), w = w* sech(...),
 // c = sqrt(2E / I1), kappa = k c / J.  From Omega0 = (-1, 0.0008, -0.0006)
-// (u0 = -1, w0 = 0.001) the body leaves the steady rotation -c e1 and turns over to
-// the opposite one, +c e1, near t* = 5.6, at constant energy E = 0.5000212.
+// (u0 = -1, w0 = 0.001), pdot0 = p0 (0, Omega0) / 2, the body leaves the steady
+// rotation -c e1 and turns over to the opposite one, +c e1, near t* = 5.6, at
+// constant energy E = 0.5000212; h = 0.01, 1800 steps (T = 18).  As the sleigh,
+// it is reversible but not integrable in the KAM sense (not declared `integrable`).
+// experiments/scenes/suslov_steady.json: the same body and p0 with a = e3, a
+// principal axis, Pi0 = I Omega0 = (1, 1, 0) (Omega0 = (1, 0.1, 0)), pdot0 =
+// (-0.165, 0.445, 0.095, -0.135): the steady rotation at |Omega0| = 1.005, 2.9
+// turns over T = 18, E = 0.55 (the setting of the retraction preprint, García-Naranjo
+// & Jiménez, arXiv 2604.04962), exact_solution()'s case.
 #pragma once
 
 #include <array>
@@ -73,15 +74,15 @@ struct Suslov {
   static constexpr const char* name = "suslov";
   // L and omega are invariant under (q, v) -> (q, -v).
   static constexpr bool reversible = true;
-  // With a a principal axis (the default) Omega is constant: integrable.
-  static constexpr bool integrable = true;
+  // Not integrable in the KAM sense for a not a principal axis (the default; above).
+  static constexpr bool integrable = false;
   // The orientation is q itself (a unit quaternion, coordinates 0..3) and row 0
   // of omega is p . pdot = 0 (methods/group/ step on the group instead).
   static constexpr int orientation = 0;
   static constexpr int norm_row = 0;
 
   double I1 = 1.0, I2 = 10.0, I3 = 100.0;  // body inertia diag(I1, I2, I3)
-  double a1 = 0.0, a2 = 0.0, a3 = 1.0;     // <a, Omega> = 0
+  double a1 = 0.0, a2 = 0.6, a3 = 0.8;     // <a, Omega> = 0
 
   static auto parameters() {
     using P = Param<Suslov>;
@@ -94,7 +95,7 @@ struct Suslov {
   }
   // Default initial state (experiments/scenes/suslov.json has the same numbers).
   static Vec<double, 4> default_q0() { return {0.9, 0.3, 0.3, 0.1}; }
-  static Vec<double, 4> default_v0() { return {-0.165, 0.445, 0.095, -0.135}; }
+  static Vec<double, 4> default_v0() { return {0.14991, -0.45013, -0.04955, 0.14985}; }
 
   // The radial term's coefficient c: the mean of the 4 I_i.
   double radial() const { return 4.0 * (I1 + I2 + I3) / 3.0; }

@@ -197,6 +197,9 @@ json catalog() {
       cls = std::string("reversible, ") + (is_integrable<S>::value ? "integrable" : behaviour ? behaviour : "not integrable");
     else if (has_reversible_flow<S>::value)
       cls = "reversible flow, non-reversible maps";
+    // A rigid body (its orientation a unit quaternion) is a class of its own: its
+    // candidates include the methods on the group.
+    if (quaternion_at<S>::value >= 0) cls = "rigid body";
     out["systems"].push_back({{"name", S::name},
                               {"n", S::n},
                               {"m", S::m},

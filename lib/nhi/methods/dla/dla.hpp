@@ -132,7 +132,7 @@ struct DlaStepProblem {
       return sys.template omega<T>(qc);
     };
     const Vec<T, m> wd =
-        discrete_constraint_with<S, D, T>(omega_at, disc, h, q0, q1, terms ? &cscale : nullptr);  // eq. 13 / 14
+        discrete_constraint_with<S, D, T>(sys, omega_at, disc, h, q0, q1, terms ? &cscale : nullptr);  // eq. 13 / 14
     for (int i = 0; i < n; ++i) {
       T force = cst<T>(0.0);
       for (int a = 0; a < mc; ++a) force += scale(lambda[a], W_t(i, a));

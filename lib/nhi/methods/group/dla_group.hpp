@@ -87,7 +87,12 @@ struct GroupChart {
       for (int i = 0; i < qi; ++i) y[i] = q1[i] - q0[i];
       for (int i = qi + 4; i < n; ++i) y[i - 1] = q1[i] - q0[i];
       const Vec<T, 4> p0 = q0.template segment<4>(qi), p1 = q1.template segment<4>(qi);
-      y.template segment<3>(qi) = quaternion::log_map<T>(quaternion::mul<T>(quaternion::conj<T>(p0), p1));
+      // p0^-1 p1 = p0-bar p1 / |p0|^2: a unit quaternion while |p1| = |p0| (the
+      // retraction keeps |p|, so a state off |p| = 1 stays on its own sphere).
+      const T s2 = p0[0] * p0[0] + p0[1] * p0[1] + p0[2] * p0[2] + p0[3] * p0[3];
+      Vec<T, 4> r = quaternion::mul<T>(quaternion::conj<T>(p0), p1);
+      for (int i = 0; i < 4; ++i) r[i] = r[i] / s2;
+      y.template segment<3>(qi) = quaternion::log_map<T>(r);
       return y;
     }
   }
