@@ -62,9 +62,16 @@ double fitted_q_order(const S& sys, const D& disc, const std::vector<double>& ga
     errs.push_back(
         (q_end(sys, disc, q0, v0, p0_of(h, q0, v0), h, std::lround(T / h), gamma) - qref).cwiseAbs().maxCoeff());
   }
-  // The finest triple-jump error is ~2e-10 and its local order still 4.0: the
-  // reference (tol 1e-13) is well below, so the floor sits under it.
-  const OrderFit f = fit_order(hs, errs, 1e-11);
+  // The finest triple-jump error is ~2e-10 and its local order still 4.0 on the
+  // flat scenes; on the Chaplygin sphere it is 4e-11, at the floor of the
+  // reference (tol 1e-13) and the 40 x 3 solves, where the local order falls
+  // from 3.95 to 2.4: such a tail is dropped, as in MethodContract (fit.hpp).
+  const OrderFit f = fit_order(hs, errs, 1e-11, 0, /*drop_floor_tail=*/true);
+  std::printf("      errors");
+  for (double e : errs) std::printf(" %.2e", e);
+  std::printf("; local orders");
+  for (const auto& l : f.local) std::printf(" %.2f", l.value_or(NAN));
+  std::printf("\n");
   EXPECT_TRUE(f.order.has_value()) << "too few points above the floor";
   return f.order.value_or(std::nan(""));
 }

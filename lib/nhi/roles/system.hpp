@@ -240,6 +240,23 @@ struct norm_row_of : std::integral_constant<int, -1> {};
 template <class S>
 struct norm_row_of<S, std::void_t<decltype(S::norm_row)>> : std::integral_constant<int, S::norm_row> {};
 
+// A rigid body whose L and omega read its quaternion p only through the
+// bilinear forms G(p) pdot, E(p) pdot (quaternion.hpp) and p . pdot, and its
+// other coordinates only through their velocities (`bilinear_kinematics`).  G
+// and E are antisymmetric in the sense G(p) u = -G(u) p, so on a step
+// G(p_alpha)(p1 - p0) = G(p0) p1 for every alpha: omega_d^alpha (eq. 13) does not
+// depend on alpha, and L_d^alpha (eq. 9) only through the radial term's
+// sigma_alpha = sigma_1/2 + (alpha - 1/2)|p1 - p0|^2.  sigma_alpha^2 and
+// sigma_{1-alpha}^2 differ by 4 (alpha - 1/2) sigma_1/2 |p1 - p0|^2, whose
+// derivatives on the level set of |p| (sigma_1/2 = 0) lie along p, the norm row's
+// force: the alpha and 1 - alpha rules are one map in q, which is therefore
+// self-adjoint (symmetric) and of order 2 for every alpha (tests/test_methods.cpp
+// and test_convergence.cpp measure both).
+template <class S, class = void>
+struct has_bilinear_kinematics : std::false_type {};
+template <class S>
+struct has_bilinear_kinematics<S, std::enable_if_t<S::bilinear_kinematics>> : std::true_type {};
+
 // The function g whose level set the norm row's discrete form holds (the DLA:
 // g(q_{k+1}) = g(q_k), roles/discretization.hpp): the system's own
 // norm_invariant(q) if it has one (a system in other coordinates, as

@@ -66,6 +66,9 @@ struct ChaplyginSphere {
   // p . pdot = 0 (methods/group/ step on the group instead).
   static constexpr int orientation = 2;
   static constexpr int norm_row = 0;
+  // L and omega read q only through xdot, 2 G(p) pdot, 2 E(p) pdot and p . pdot
+  // (no potential): the DLA's alpha rules are all of order 2 here (system.hpp).
+  static constexpr bool bilinear_kinematics = true;
 
   double mass = 1.0;  // m
   double r = 1.0;     // radius

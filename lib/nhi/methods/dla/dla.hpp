@@ -261,8 +261,10 @@ class DlaStepper {
 
   MethodTraits traits() const {
     MethodTraits t;
-    t.order = map_.discretization().order();
-    t.symmetric = map_.discretization().symmetric();
+    // (every alpha rule is of order 2 and symmetric on a rigid body's bilinear
+    // kinematics, system.hpp)
+    t.order = has_bilinear_kinematics<S>::value ? 2 : map_.discretization().order();
+    t.symmetric = has_bilinear_kinematics<S>::value || map_.discretization().symmetric();
     t.symmetric_in_phase = false;  // positions only (see the top of this file)
     t.holds_velocity_constraint = false;
     t.implicit = true;
