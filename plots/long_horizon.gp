@@ -56,7 +56,7 @@ set multiplot title sprintf("Long horizon, h = %s, 10^6 steps, T = %.4g (%s; the
 eval panel(1)
 set title "main methods: energy"
 set ylabel "max_{s ≤ t} |E − E_0|".U
-set key at screen 0.02, bot - 0.09 left top vertical maxrows 11 Left reverse font ",9" samplen 3.5 nobox noopaque
+set key at screen 0.02, bot - 0.09 left top vertical maxrows 14 Left reverse font ",9" samplen 3.5 nobox noopaque
 plot for [k=1:N] sprintf("$E%d", ORD[k] - 1) u 1:2 w l ls sty(ORD[k]) notitle, \
      for [k=1:N] sprintf("$E%d", ORD[k] - 1) every EV::(3 * k % EV) u 1:2 w p ls sty(ORD[k]) notitle, \
      for [k=1:N] keyentry w lp ls sty(ORD[k]) t (group(ORD[k]) eq "main" ? label(ORD[k]) : "")
@@ -70,7 +70,7 @@ eval panel(3)
 set title "variants (other {/Symbol a}, compositions): energy"
 set ylabel "max_{s ≤ t} |E − E_0|".U
 set yrange [1e-12:1e6]
-set key at screen 0.52, bot - 0.09 left top vertical maxrows 11 Left reverse font ",9" samplen 3.5 nobox noopaque
+set key at screen 0.52, bot - 0.09 left top vertical maxrows 14 Left reverse font ",9" samplen 3.5 nobox noopaque
 plot for [k=1:N] sprintf("$V%d", ORD[k] - 1) u 1:2 w l ls sty(ORD[k]) notitle, \
      for [k=1:N] sprintf("$V%d", ORD[k] - 1) every EV::(3 * k % EV) u 1:2 w p ls sty(ORD[k]) notitle, \
      for [k=1:N] keyentry w lp ls sty(ORD[k]) t (group(ORD[k]) eq "variant" ? label(ORD[k]) : "")

@@ -334,8 +334,12 @@ jq -r '"\(.config.steps) steps of h = \(.config.h) on each scene that declares i
 echo
 echo "| method | $(jq -r '[.scenes | keys_unsorted[]] | join(" | ")' "$R/global_error.json") |"
 echo "|---|$(jq -r '[.scenes | keys_unsorted[] | "---"] | join("|")' "$R/global_error.json")|"
-jq -r "$G"'(.scenes | keys_unsorted) as $sc | [.scenes[$sc[]].methods] | transpose[] |
-  "| \(.[0].label) | " + (map(if .status != "ok" then "failed" else "t^\(.growth_exponent | g) (\(.fit_points) points; \(.error[-1] | g) at T)" end) | join(" | ")) + " |"' "$R/global_error.json"
+# Rows by label (a method studied on some scenes only, as dla-group on the
+# rigid bodies, has "-" elsewhere).
+jq -r "$G"'. as $root | ($root.scenes | keys_unsorted) as $sc |
+  ([$root.scenes[$sc[]].methods[].label] | reduce .[] as $l ([]; if index($l) then . else . + [$l] end))[] as $l |
+  "| \($l) | " + ([$sc[] | . as $s | ([$root.scenes[$s].methods[] | select(.label == $l)][0]) |
+    if . == null then "-" elif .status != "ok" then "failed" else "t^\(.growth_exponent | g) (\(.fit_points) points; \(.error[-1] | g) at T)" end] | join(" | ")) + " |"' "$R/global_error.json"
 echo
 fi
 
