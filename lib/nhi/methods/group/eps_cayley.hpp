@@ -56,7 +56,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -140,7 +139,8 @@ struct EpsCayleyStepProblem {
 
 // The stepper (stepper.hpp), lag 0: each step reports its end point.  On a
 // system that is not a Suslov body (is_suslov_body) it compiles, so that the
-// method table can name it for every scene, and its constructor throws.
+// method table can name it for every scene (and `nhi list` read its traits),
+// and every step fails (kSolve) saying why.
 // Reported: q_k = s u_k, v_k = G(q_k)^T Omega_k / 2 (v_0 as given), p_k =
 // dL/dqdot(q_k, v_k) (the embedding's momentum of that velocity; phase() is
 // (q_k, p_k)), lambda row 1 the impulse lambda_k of the step that reached k,
@@ -160,10 +160,6 @@ class EpsCayleyStepper {
     if constexpr (kApplies) {
       J_ = sys.inertia();
       a_ = sys.suslov_axis();
-    } else {
-      throw std::invalid_argument(std::string("eps_cayley steps a free rigid body with a left-invariant constraint "
-                                              "(the Suslov problem); not ") +
-                                  S::name);
     }
   }
 

@@ -6,6 +6,8 @@
 // system outside the registry.
 #pragma once
 
+#include <string>
+
 #include "nhi/methods/group/eps_cayley.hpp"
 
 namespace nhi {
@@ -15,7 +17,8 @@ StepSummary EpsCayleyStepper<S>::step(double h) {
   StepSummary st;
   if constexpr (!kApplies) {
     st.failure = FailureKind::kSolve;
-    st.message = "eps_cayley: not a Suslov body";
+    st.message = std::string("eps_cayley steps a free rigid body with a left-invariant constraint on Omega "
+                             "(the Suslov problem), not ") + S::name;
     return st;
   } else {
     // Start: y ~ h Omega(t_{k+1/2}); from the second step on the extrapolation
