@@ -1,11 +1,11 @@
 // The discrete Euler-Poincare-Suslov step with the Cayley retraction
 // (methods/group/eps_cayley.hpp) on the Suslov problem: its residual's
 // Jacobian is the residual's derivative; it reproduces the steady rotation
-// (suslov.json) and the Fedorov-Zenkov turnover (suslov_fz.json) with its
+// (suslov_steady.json) and the Fedorov-Zenkov turnover (suslov.json) with its
 // declared order 2; it holds <a, Omega_k> = 0 and <a, y_k> = 0 and |p| = 1
 // to round-off; its energy is exact on the steady rotations and returns
 // after the turnover; it is self-adjoint and rho-reversible in (q, v); and,
-// the claim to measure, its discrete flow on suslov_fz travels to the steady
+// the claim to measure, its discrete flow on suslov.json travels to the steady
 // rotation +c e1 at a rate kappa_h that tends to the continuous kappa as h^2
 // (the group DLA and the embedded midpoint DLA measured beside it).
 #include <cmath>
@@ -29,14 +29,14 @@ static_assert(!EpsCayleyMethod::studied_on<Sleigh>());
 
 Vec3 body_rate(const Vec4& q, const Vec4& v) { return 2.0 * qn::G<double>(q, v) / q.squaredNorm(); }
 
-// experiments/scenes/suslov_fz.json: the system, its state and its h.
+// A Suslov scene file (experiments/scenes/): the system, its state and its h.
 struct FzScene {
   Suslov sys;
   Vec4 q0, v0;
   double h = 0, T = 0;
 };
-FzScene fz_scene() {
-  const json sc = validate_scene(load_scene_file(std::string(NHI_SCENES) + "/suslov_fz.json"));
+FzScene scene_file(const std::string& file) {
+  const json sc = validate_scene(load_scene_file(std::string(NHI_SCENES) + "/" + file));
   FzScene f;
   f.sys.I1 = sc["params"]["I1"], f.sys.I2 = sc["params"]["I2"], f.sys.I3 = sc["params"]["I3"];
   f.sys.a1 = sc["params"]["a1"], f.sys.a2 = sc["params"]["a2"], f.sys.a3 = sc["params"]["a3"];
@@ -80,13 +80,14 @@ TEST(EpsCayley, JacobianIsTheResidualsDerivative) {
   }
 }
 
-// suslov.json (a = e3, principal): every motion is a steady rotation, and so
+// suslov_steady.json (a = e3, principal): every motion is a steady rotation, and so
 // is the discrete one: y_k = y_0 solves (DEPS) at every step (y^ J y is along
 // a), so Omega_k = Omega_0 and the energy is exact; the rotation's phase is
 // of order 2 (2 atan(|y|/2) per step against h |Omega|).
 TEST(EpsCayley, SuslovSteadyRotationAtOrderTwo) {
-  const Suslov sys;
-  const Vec4 q0 = Suslov::default_q0(), v0 = Suslov::default_v0();
+  const FzScene f = scene_file("suslov_steady.json");
+  const Suslov& sys = f.sys;
+  const Vec4 q0 = f.q0, v0 = f.v0;
   const double T = 4, E0 = energy(sys, q0, v0);
   std::vector<double> hs, errs;
   for (double h : {0.1, 0.05, 0.025, 0.0125}) {
@@ -111,10 +112,10 @@ TEST(EpsCayley, SuslovSteadyRotationAtOrderTwo) {
   EXPECT_NEAR(*f.order, 2.0, 0.1);
 }
 
-// suslov_fz.json (a not principal): q(T), Omega(T) against the reference
-// solution (tol 1e-13) over T = 8, through the turnover near t* = 5.6.
+// suslov.json (a not principal): q(T), Omega(T) against the reference
+// solution (tol 1e-13) over T = 8, through the turnover near t* = 1.02.
 TEST(EpsCayley, FedorovZenkovTurnoverAtOrderTwo) {
-  const FzScene f = fz_scene();
+  const FzScene f = scene_file("suslov.json");
   const double T = 8;
   Vec4 qr, vr;
   reference_solution(f.sys, f.q0, f.v0, T, 1e-13, &qr, &vr);
@@ -135,9 +136,9 @@ TEST(EpsCayley, FedorovZenkovTurnoverAtOrderTwo) {
 
 // On the group and on the constraint: ||p| - 1|, <a, Omega_k> (the reported
 // velocity) and <a, y_k>/h (the discrete constraint) at round-off over 10^4
-// steps of suslov_fz.json's h, and the norm row of the velocity too.
+// steps of suslov.json's h, and the norm row of the velocity too.
 TEST(EpsCayley, StaysOnTheGroupAndHoldsTheConstraint) {
-  const FzScene f = fz_scene();
+  const FzScene f = scene_file("suslov.json");
   const auto s = run_eps(f.sys, f.q0, f.v0, f.h, 10000);
   const Vec3 a = f.sys.suslov_axis();
   double norm = 0, aOm = 0, ay = 0, row0 = 0, Om = 0;
@@ -161,7 +162,7 @@ TEST(EpsCayley, StaysOnTheGroupAndHoldsTheConstraint) {
 // From a quaternion of norm s != 1 the motion is s times the unit one (suslov.hpp):
 // the step keeps |p| = s and gives s times the unit run.
 TEST(EpsCayley, KeepsANonUnitNormAndScales) {
-  const FzScene f = fz_scene();
+  const FzScene f = scene_file("suslov.json");
   const double sc = 1.7;
   const auto a = run_eps(f.sys, f.q0, f.v0, 0.05, 200), b = run_eps(f.sys, sc * f.q0, sc * f.v0, 0.05, 200);
   double dq = 0, dn = 0;
@@ -173,12 +174,12 @@ TEST(EpsCayley, KeepsANonUnitNormAndScales) {
   EXPECT_LT(dn, 16 * kEps);
 }
 
-// Energy over a long horizon on suslov_fz: |E - E0| is O(h^2) during the
+// Energy over a long horizon on suslov.json: |E - E0| is O(h^2) during the
 // turnover and comes back after it (the discrete flow settles on a steady
 // rotation, where E is constant): the last quarter of T = 2000 is flat,
 // no larger than at the end of the first quarter.
 TEST(EpsCayley, EnergyComesBackAfterTheTurnover) {
-  const FzScene f = fz_scene();
+  const FzScene f = scene_file("suslov.json");
   const double E0 = energy(f.sys, f.q0, f.v0);
   for (double h : {0.2, 0.1, 0.05}) {
     const long steps = std::lround(2000 / h);
@@ -203,7 +204,7 @@ TEST(EpsCayley, EnergyComesBackAfterTheTurnover) {
 // Self-adjoint and rho-reversible in (q, v), through the stepper's phase (q, p):
 // h then -h returns to the start; from (q_1, -v_1) a step of h reaches (q_0, -v_0).
 TEST(EpsCayley, ReturnsAfterHThenMinusHAndUnderTheVelocityFlip) {
-  const FzScene f = fz_scene();
+  const FzScene f = scene_file("suslov.json");
   for (double h : {0.2, -0.1}) {
     EpsCayleyStepper<Suslov> st(f.sys);
     st.start(f.q0, f.v0);
@@ -228,7 +229,7 @@ TEST(EpsCayley, ReturnsAfterHThenMinusHAndUnderTheVelocityFlip) {
   }
 }
 
-// The claim to measure: on suslov_fz the continuous flow leaves -c e1 and
+// The claim to measure: on suslov.json the continuous flow leaves -c e1 and
 // tends to the steady rotation +c e1 with w = <Omega, b> ~ exp(-kappa t),
 // kappa = k c / J (test_rigid.cpp: the sleigh's reduced equations).  The
 // discrete flow of eps_cayley travels there too: Omega_k -> c_h e1 with
@@ -261,7 +262,7 @@ Decay decay(const Suslov& sys, const MethodSpec& spec, const Vec4& q0, const Vec
 }
 
 TEST(EpsCayley, FedorovZenkovDiscreteFlowTravelsToTheSteadyRotation) {
-  const FzScene f = fz_scene();
+  const FzScene f = scene_file("suslov.json");
   const Suslov& sys = f.sys;
   const Vec3 a = sys.suslov_axis(), b(0, a[2], -a[1]), Jv = sys.inertia();
   const Vec3 Om0 = body_rate(f.q0, f.v0);

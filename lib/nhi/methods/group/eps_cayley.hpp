@@ -271,7 +271,7 @@ struct EpsCayleyMethod {
   static constexpr bool studied_on() {
     return is_suslov_body<S>::value;
   }
-  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", 83}}; }
+  static std::vector<StudyEntry> study_entries() { return {{spec_of(name), "main", 85}}; }
 };
 
 }  // namespace nhi
