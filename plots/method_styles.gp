@@ -14,6 +14,7 @@ method_ls(label) = \
   label eq "discrete_gradient" ? 31 : \
   label eq "discrete_gradient+triple_jump" ? 32 : \
   label eq "dla-group a=0.5" ? 81 : \
+  label eq "eps-cayley" ? 85 : \
   label eq "dla a=0" ? 15 : \
   label eq "dla a=0.25" ? 16 : \
   label eq "dla a=0.75" ? 17 : \

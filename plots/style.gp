@@ -67,6 +67,7 @@ set style line 76 lc rgb "#0072B2" lw 1.5 dt @DASH pt 8  ps 0.9
 set style line 77 lc rgb "#0072B2" lw 1.5 dt @DASHDOT pt 12 ps 0.9
 set style line 78 lc rgb "#0072B2" lw 1.5 dt @DOT pt 4  ps 0.8
 set style line 81 lc rgb "#882255" lw 1.5 dt 1 pt 13 ps 0.9
+set style line 85 lc rgb "#882255" lw 1.5 dt @DASH pt 11 ps 0.9
 set style line 99 lc rgb "#999999" lw 1.0 dt 1 pt 6  ps 0.8
 # The methods' styles by label (method_ls), written from their declarations by
 # `nhi list --gnuplot`; other_ls: the convergence study's isolation runs, else grey.

@@ -39,6 +39,7 @@
 #include "nhi/methods/explicit/embedded_rk.hpp"
 #include "nhi/methods/explicit/rk4.hpp"
 #include "nhi/methods/group/dla_group.hpp"
+#include "nhi/methods/group/eps_cayley.hpp"
 #include "nhi/methods/method_spec.hpp"
 #include "nhi/methods/mp06/mp06.hpp"
 #include "nhi/methods/reference/reference.hpp"
@@ -51,7 +52,7 @@ namespace nhi {
 
 // Every method the library has.
 using Methods = TypeList<DlaMethod, Rk4Method, ReferenceMethod, Mp06Method, DiscreteGradientMethod, SparkMethod,
-                         Rkf78Method, Dopri5Method, GroupDlaMethod>;
+                         Rkf78Method, Dopri5Method, GroupDlaMethod, EpsCayleyMethod>;
 
 inline std::vector<std::string> method_names() {
   std::vector<std::string> names;

@@ -90,6 +90,13 @@ struct Suslov {
   double I1 = 1.0, I2 = 2.0, I3 = 6.0;     // body inertia diag(I1, I2, I3)
   double a1 = 0.0, a2 = 0.6, a3 = 0.8;     // <a, Omega> = 0
 
+  // A free rigid body with a left-invariant constraint on Omega: what
+  // methods/group/eps_cayley.hpp (which steps such a body on SO(3) itself)
+  // reads, and the trait by which it is studied on this scene only.
+  static constexpr bool left_invariant_constraint = true;
+  Vec<double, 3> inertia() const { return Vec<double, 3>(I1, I2, I3); }
+  Vec<double, 3> suslov_axis() const { return Vec<double, 3>(a1, a2, a3); }
+
   static auto parameters() {
     using P = Param<Suslov>;
     return std::array{P{"I1", &Suslov::I1, ParamCheck::kPositive},
