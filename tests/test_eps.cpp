@@ -85,9 +85,9 @@ TEST(EpsCayley, JacobianIsTheResidualsDerivative) {
 // a), so Omega_k = Omega_0 and the energy is exact; the rotation's phase is
 // of order 2 (2 atan(|y|/2) per step against h |Omega|).
 TEST(EpsCayley, SuslovSteadyRotationAtOrderTwo) {
-  const FzScene f = scene_file("suslov_steady.json");
-  const Suslov& sys = f.sys;
-  const Vec4 q0 = f.q0, v0 = f.v0;
+  const FzScene sc = scene_file("suslov_steady.json");
+  const Suslov& sys = sc.sys;
+  const Vec4 q0 = sc.q0, v0 = sc.v0;
   const double T = 4, E0 = energy(sys, q0, v0);
   std::vector<double> hs, errs;
   for (double h : {0.1, 0.05, 0.025, 0.0125}) {
@@ -103,8 +103,9 @@ TEST(EpsCayley, SuslovSteadyRotationAtOrderTwo) {
     errs.push_back((s.back().q - q).cwiseAbs().maxCoeff());
     std::printf("    h = %-7g |q(T) - q_exact(T)| = %.3e, max |Omega_k - Omega_0| = %.1e, max |E - E0| = %.1e\n", h,
                 errs.back(), dOm, dE);
-    EXPECT_LT(dOm, 64 * kEps);
-    EXPECT_LT(dE, 64 * kEps * E0);
+    // To the step solve's tolerance (the solver stops within it of y_0).
+    EXPECT_LT(dOm, 10 * kDefaultTolerance * (1 + body_rate(q0, v0).norm()));
+    EXPECT_LT(dE, 10 * kDefaultTolerance * E0);
   }
   const OrderFit f = fit_order(hs, errs, 1e-12);
   ASSERT_TRUE(f.order);
@@ -174,11 +175,11 @@ TEST(EpsCayley, KeepsANonUnitNormAndScales) {
   EXPECT_LT(dn, 16 * kEps);
 }
 
-// Energy over a long horizon on suslov.json: |E - E0| is O(h^2) during the
-// turnover and comes back after it (the discrete flow settles on a steady
-// rotation, where E is constant): the last quarter of T = 2000 is flat,
-// no larger than at the end of the first quarter.
-TEST(EpsCayley, EnergyComesBackAfterTheTurnover) {
+// Energy over a long horizon on suslov.json: |E - E0| is O(h^2) and does
+// not come back after the turnover: the discrete flow settles on a steady
+// rotation c_h e1 with c_h - c = O(h^2) (below), so E stays off by O(h^2),
+// as at T/4, and is flat in the last quarter of T = 2000.
+TEST(EpsCayley, EnergyErrorIsSecondOrderAndSettles) {
   const FzScene f = scene_file("suslov.json");
   const double E0 = energy(f.sys, f.q0, f.v0);
   for (double h : {0.2, 0.1, 0.05}) {
@@ -195,9 +196,9 @@ TEST(EpsCayley, EnergyComesBackAfterTheTurnover) {
     ASSERT_TRUE(rep.ok) << rep.reason;
     std::printf("    h = %-5g max |E - E0| = %.2e (%.1e E0 / h^2), E - E0 at T/4 %.2e, spread in the last quarter %.1e\n",
                 h, worst, worst / (E0 * h * h), first_end, last_hi - last_lo);
-    EXPECT_LT(worst, 0.3 * E0 * h * h);  // (measured 0.24)
-    EXPECT_LT(std::abs(first_end), 1e-3 * worst);
-    EXPECT_LT(last_hi - last_lo, 1e-12 * E0);
+    EXPECT_LT(worst, 0.3 * E0 * h * h);  // (measured 0.064)
+    EXPECT_GT(std::abs(first_end), 0.5 * worst);
+    EXPECT_LT(last_hi - last_lo, 1e-6 * worst);  // (measured at most 2.4e-7)
   }
 }
 
@@ -292,7 +293,8 @@ TEST(EpsCayley, FedorovZenkovDiscreteFlowTravelsToTheSteadyRotation) {
               fc.order ? std::to_string(*fc.order).c_str() : "below 1e-12");
   EXPECT_NEAR(*fk.order, 2.0, 0.15);
   EXPECT_LT(dk.front(), 0.02 * kappa);  // h = 0.2: within 2 %
-  for (double x : dc) EXPECT_LT(x, 1e-5);
+  ASSERT_TRUE(fc.order);
+  EXPECT_NEAR(*fc.order, 2.0, 0.15);  // c_h - c = O(h^2)
 }
 
 }  // namespace

@@ -64,7 +64,7 @@ Vec<double, 4> suslov_v0() { return Suslov::default_v0(); }
 // (suslov.hpp; experiments/scenes/suslov_steady.json): the midpoint group DLA
 // converges to it with order 2.
 TEST(GroupDla, SuslovSteadyRotationAtOrderTwo) {
-  const json sc = load_scene_file(std::string(NHI_SCENES) + "/suslov_steady.json");  // (suslov is not registered yet)
+  const json sc = validate_scene(load_scene_file(std::string(NHI_SCENES) + "/suslov_steady.json"));
   Suslov sys;
   sys.a1 = sc["params"]["a1"], sys.a2 = sc["params"]["a2"], sys.a3 = sc["params"]["a3"];
   ASSERT_TRUE(sys.principal_axis());

@@ -9,7 +9,6 @@
 // discrete constraint p_mid . (p1 - p0) = (|p1|^2 - |p0|^2) / 2 = 0 holding |p|.
 #include <fstream>
 
-// Suslov is not registered (systems/registry.hpp): its steppers are compiled here.
 #include "nhi/methods/dla/dla_body.hpp"
 #include "nhi/methods/reference/reference_body.hpp"
 #include "nhi/runner/scene.hpp"
@@ -213,7 +212,7 @@ TEST(Suslov, SteadyRotationIsTheReferenceSolution) {
 // kappa = k c / J, w* = c sqrt(I1 / J): the body turns over from the steady
 // rotation -c e1 to +c e1 at constant energy.  Against the reference solution.
 TEST(Suslov, FedorovZenkovSceneTurnsOverAtConstantEnergy) {
-  const json sc = load_scene_file(std::string(NHI_SCENES) + "/suslov.json");  // (suslov is not registered yet)
+  const json sc = validate_scene(load_scene_file(std::string(NHI_SCENES) + "/suslov.json"));
   Suslov sys;
   sys.I1 = sc["params"]["I1"], sys.I2 = sc["params"]["I2"], sys.I3 = sc["params"]["I3"];
   sys.a1 = sc["params"]["a1"], sys.a2 = sc["params"]["a2"], sys.a3 = sc["params"]["a3"];

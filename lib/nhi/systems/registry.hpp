@@ -34,14 +34,9 @@ namespace nhi {
   X(Sleigh)                       \
   X(RollingDisk)                  \
   X(MagneticParticle)             \
-  X(ChaplyginSphere)
+  X(ChaplyginSphere)              \
+  X(Suslov)
 // clang-format on
-// Suslov (suslov.hpp) is not registered yet: on its default state three typed
-// contracts fail at round-off or at the reference's floor (the discrete
-// gradient's triple jump keeps E to 1.1e-11 over 10^4 steps against the round-off
-// bound 3.0e-12; its order-6 composition returns after h, -h to 1.5e-13 against
-// 1.3e-13; SPARK s = 4 has fewer than 3 errors above 1e-10).  Its own tests
-// (tests/test_rigid.cpp, test_group.cpp) run it directly.
 
 #define NHI_COMMA_THEN_(S) , S
 using Systems = typename Rest<TypeList<void NHI_REGISTERED_SYSTEMS(NHI_COMMA_THEN_)>>::type;

@@ -232,6 +232,13 @@ json catalog() {
                   {"style", m.style}};
     // Every method key: its value where the method has it, else null; "own"
     // lists the method's keys in their declared order.
+    // The registered systems the method is studied on (StudyMethod::on): the
+    // scenes a study runs it on, and where `nhi run` is sure to take it.
+    entry["systems"] = json::array();
+    for_each_type(Systems{}, [&](auto tag) {
+      using S = typename decltype(tag)::type;
+      if (m.template on<S>()) entry["systems"].push_back(S::name);
+    });
     for (const MethodKey& k : all_method_keys()) entry[k.name] = nullptr;
     entry["own"] = json::array();
     for (const MethodKey& k : method_flags(m.spec.kind).keys) {
