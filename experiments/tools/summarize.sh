@@ -48,14 +48,17 @@ jq -r "$G"'
 echo
 fi
 
-echo "## Convergence (results/convergence.json): fitted order, 4 finest h above 1e-10"
+echo "## Convergence (results/convergence.json): fitted order, 4 finest h above the floor (1e-10, or 3 x the reference's own error where larger; \"-\": fewer than 3 points above it, or not studied)"
 echo
-# One column per scene in the file (every registered scene), one row per method.
+# One column per scene in the file (every registered scene), one row per method,
+# matched by label ("-" where a scene does not study the method: the group methods).
 jq -r "$G"'
   (.scenes | keys_unsorted) as $sc |
+  ([.scenes[].methods[].label] | reduce .[] as $l ([]; if any(.[]; . == $l) then . else . + [$l] end)) as $labels |
   "| method | \($sc | join(" | ")) |", "|---|\($sc | map("---|") | join(""))",
-  ([.scenes[$sc[]].methods] | transpose[] |
-   "| \(.[0].label) | \(map(.fitted_order | g) | join(" | ")) |")' "$R/convergence.json"
+  ($labels[] as $l | . as $root |
+   "| \($l) | \([$sc[] | . as $s | $root.scenes[$s].methods | map(select(.label == $l)) |
+                  if length > 0 then (.[0].fitted_order | g) else "-" end] | join(" | ")) |")' "$R/convergence.json"
 echo
 
 if jq -e '[.scenes[].methods[] | select(.limit_speed_error != null)] | length > 0' "$R/convergence.json" > /dev/null; then
