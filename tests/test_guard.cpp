@@ -11,6 +11,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <unistd.h>
 
 #include "nhi/methods/reference/reference.hpp"
 #include "nhi/roles/guard.hpp"
@@ -28,15 +29,16 @@ struct CliRun {
   json result;
 };
 CliRun nhi_run(const std::string& scene, const std::string& sets) {
-  const std::string out = testing::TempDir() + "nhi_guard_result.json";
+  // One file per process: ctest runs each test as its own process, two at a time.
+  const std::string out = testing::TempDir() + "nhi_guard_result_" + std::to_string(::getpid()) + ".json";
   std::filesystem::remove(out);
   const std::string cmd =
       std::string(NHI_BINARY) + " run " + NHI_SCENES + "/" + scene + " " + sets + " -o " + out + " 2> /dev/null";
   const int status = std::system(cmd.c_str());
   CliRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(out);
-  if (in) r.result = json::parse(in);
+  if (std::ifstream in(out); in) r.result = json::parse(in);
+  std::filesystem::remove(out);
   return r;
 }
 
